@@ -1,0 +1,477 @@
+//! The 263-float HumanML3D motion features, computed from joint positions and turned back into
+//! joint positions, plus their normalisation and left/right mirroring.
+//!
+//! One row per frame at 20 fps (a motion of `T` joint frames gives `T − 1` rows):
+//!
+//! | columns    | meaning                                                                  |
+//! |------------|--------------------------------------------------------------------------|
+//! | 0          | root angular velocity about +Y, radians per frame, stored as half-angle |
+//! | 1..3       | root linear velocity (x, z) in the root's facing frame, m per frame      |
+//! | 3          | root (pelvis) height above the floor, m                                  |
+//! | 4..67      | joints 1–21 relative to the root, in the facing frame, m (21 × 3)        |
+//! | 67..193    | 6D rotations of joints 1–21 relative to their parents (21 × 6)           |
+//! | 193..259   | velocities of joints 0–21 in the facing frame, m per frame (22 × 3)      |
+//! | 259..263   | foot contacts (left ankle, left foot, right ankle, right foot), 0 or 1   |
+
+use crate::geom::{self, Quat, Vec3};
+use crate::npy::{NpyArray, NpyError};
+use crate::skeleton::{self, joint, Offsets, Pose, NUM_JOINTS};
+use std::ops::Range;
+
+pub mod check;
+
+/// Floats per frame.
+pub const FEATURE_DIM: usize = 263;
+/// Frames per second of every motion in the product.
+pub const FPS: f64 = 20.0;
+/// Root angular velocity (column 0).
+pub const ROOT_ROT_VEL: Range<usize> = 0..1;
+/// Root linear velocity on the ground plane (columns 1, 2).
+pub const ROOT_LIN_VEL: Range<usize> = 1..3;
+/// Root height (column 3).
+pub const ROOT_HEIGHT: Range<usize> = 3..4;
+/// Root-relative joint positions ("ric").
+pub const POSITIONS: Range<usize> = 4..67;
+/// 6D joint rotations.
+pub const ROTATIONS: Range<usize> = 67..193;
+/// Joint velocities.
+pub const VELOCITIES: Range<usize> = 193..259;
+/// Foot contacts.
+pub const CONTACTS: Range<usize> = 259..263;
+
+/// Named column groups, for reports and per-group normalisation.
+pub const GROUPS: [(&str, Range<usize>); 7] = [
+    ("root angular velocity", ROOT_ROT_VEL),
+    ("root linear velocity", ROOT_LIN_VEL),
+    ("root height", ROOT_HEIGHT),
+    ("joint positions", POSITIONS),
+    ("6D rotations", ROTATIONS),
+    ("joint velocities", VELOCITIES),
+    ("foot contacts", CONTACTS),
+];
+
+/// Squared per-frame displacement (m²) under which a foot joint counts as in contact.
+pub const FOOT_CONTACT_THRESHOLD: f64 = 0.002;
+
+/// One frame of features.
+pub type FeatureFrame = [f32; FEATURE_DIM];
+
+/// Motion features, one row per frame.
+pub type Features = Vec<FeatureFrame>;
+
+/// Why features could not be computed or read.
+#[derive(Debug, thiserror::Error)]
+pub enum FeatureError {
+    #[error("a motion needs at least 2 frames, got {0}")]
+    TooShort(usize),
+    #[error("motion contains a non-finite value (NaN or infinity) at frame {0}")]
+    NonFinite(usize),
+    #[error(transparent)]
+    Npy(#[from] NpyError),
+}
+
+/// Converts joint positions (any skeleton of the 22 SMPL joints, any place and facing) into
+/// features, the way HumanML3D builds its dataset: bones take the `target` lengths, the
+/// motion is put on the floor, moved so the first frame's root is at the origin and turned so
+/// the first frame faces +Z. Returns the `T − 1` feature rows and the `T` processed joint
+/// positions they describe.
+pub fn joints_to_features(
+    poses: &[Pose],
+    target: &Offsets,
+) -> Result<(Features, Vec<Pose>), FeatureError> {
+    if poses.len() < 2 {
+        return Err(FeatureError::TooShort(poses.len()));
+    }
+    if let Some(t) = poses
+        .iter()
+        .position(|p| p.iter().flatten().any(|v| !v.is_finite()))
+    {
+        return Err(FeatureError::NonFinite(t));
+    }
+    let mut positions = skeleton::uniform_skeleton(poses, target);
+
+    // On the floor, first root at the origin on the ground plane, first frame facing +Z.
+    let floor = positions
+        .iter()
+        .flat_map(|p| p.iter().map(|v| v[1]))
+        .fold(f64::INFINITY, f64::min);
+    let first = positions[0];
+    let origin = [first[0][0], floor, first[0][2]];
+    let [r_hip, l_hip, r_sdr, l_sdr] = skeleton::FACE_JOINTS;
+    let across = geom::normalize(geom::add(
+        geom::sub(first[r_hip], first[l_hip]),
+        geom::sub(first[r_sdr], first[l_sdr]),
+    ));
+    let forward = geom::normalize(geom::cross([0.0, 1.0, 0.0], across));
+    let face = Quat::between(forward, [0.0, 0.0, 1.0]);
+    for pose in &mut positions {
+        for p in pose.iter_mut() {
+            *p = face.rotate(geom::sub(*p, origin));
+        }
+    }
+    let global = positions.clone();
+    let t_rows = positions.len() - 1;
+
+    let contact = |j: usize, t: usize| -> f32 {
+        let d = geom::sub(global[t + 1][j], global[t][j]);
+        (geom::dot(d, d) < FOOT_CONTACT_THRESHOLD) as u8 as f32
+    };
+
+    // Per-bone rotations with a smoothed facing; the root rotation turns world into facing.
+    let rotations = skeleton::inverse_kinematics(&positions, true);
+    let root_rot: Vec<Quat> = rotations.iter().map(|r| r[0]).collect();
+
+    let mut rows = Vec::with_capacity(t_rows);
+    for t in 0..t_rows {
+        let mut row = [0f32; FEATURE_DIM];
+        let r_vel = root_rot[t + 1].mul(root_rot[t].inv());
+        row[0] = r_vel.0[2].clamp(-1.0, 1.0).asin() as f32;
+        let lin = root_rot[t + 1].rotate(geom::sub(global[t + 1][0], global[t][0]));
+        row[1] = lin[0] as f32;
+        row[2] = lin[2] as f32;
+        row[3] = global[t][0][1] as f32;
+        let root = global[t][0];
+        for j in 1..NUM_JOINTS {
+            let local = [
+                global[t][j][0] - root[0],
+                global[t][j][1],
+                global[t][j][2] - root[2],
+            ];
+            let p = root_rot[t].rotate(local);
+            let c = POSITIONS.start + (j - 1) * 3;
+            row[c..c + 3].copy_from_slice(&p.map(|v| v as f32));
+            let m = rotations[t][j].to_matrix();
+            let c = ROTATIONS.start + (j - 1) * 6;
+            let six = [m[0][0], m[1][0], m[2][0], m[0][1], m[1][1], m[2][1]];
+            row[c..c + 6].copy_from_slice(&six.map(|v| v as f32));
+        }
+        for j in 0..NUM_JOINTS {
+            let v = root_rot[t].rotate(geom::sub(global[t + 1][j], global[t][j]));
+            let c = VELOCITIES.start + j * 3;
+            row[c..c + 3].copy_from_slice(&v.map(|v| v as f32));
+        }
+        row[CONTACTS.start] = contact(joint::L_ANKLE, t);
+        row[CONTACTS.start + 1] = contact(joint::L_FOOT, t);
+        row[CONTACTS.start + 2] = contact(joint::R_ANKLE, t);
+        row[CONTACTS.start + 3] = contact(joint::R_FOOT, t);
+        rows.push(row);
+    }
+    Ok((rows, global))
+}
+
+/// The root's facing rotation (about +Y) and position per frame, integrated from the root
+/// velocities of the features: the motion starts at the origin facing +Z.
+pub fn recover_root(features: &[FeatureFrame]) -> (Vec<Quat>, Vec<Vec3>) {
+    let mut rots = Vec::with_capacity(features.len());
+    let mut pos = Vec::with_capacity(features.len());
+    let mut angle = 0.0f64;
+    let mut p = [0.0f64; 3];
+    for (t, row) in features.iter().enumerate() {
+        if t > 0 {
+            let prev = &features[t - 1];
+            angle += prev[0] as f64;
+            // Velocity of frame t−1 is expressed in the facing of frame t.
+            let q = Quat([angle.cos(), 0.0, angle.sin(), 0.0]);
+            let step = q.inv().rotate([prev[1] as f64, 0.0, prev[2] as f64]);
+            p = geom::add(p, step);
+        }
+        rots.push(Quat([angle.cos(), 0.0, angle.sin(), 0.0]));
+        pos.push([p[0], row[3] as f64, p[2]]);
+    }
+    (rots, pos)
+}
+
+/// Joint positions (metres, world frame) from features: integrates the root and places the
+/// root-relative positions around it. One pose per feature row.
+pub fn features_to_joints(features: &[FeatureFrame]) -> Vec<Pose> {
+    let (rots, root) = recover_root(features);
+    features
+        .iter()
+        .zip(rots.iter().zip(&root))
+        .map(|(row, (q, r))| {
+            let inv = q.inv();
+            let mut pose = [[0.0; 3]; NUM_JOINTS];
+            pose[0] = *r;
+            for (j, slot) in pose.iter_mut().enumerate().skip(1) {
+                let c = POSITIONS.start + (j - 1) * 3;
+                let local = inv.rotate([row[c] as f64, row[c + 1] as f64, row[c + 2] as f64]);
+                *slot = [local[0] + r[0], local[1], local[2] + r[2]];
+            }
+            pose
+        })
+        .collect()
+}
+
+/// Every pose the features describe: `T − 1` rows describe `T` frames, and the last one is
+/// reached by adding the last row's joint velocities (stored in the facing frame) to the
+/// last recovered pose. Feature code that smooths over time needs that final frame to
+/// reproduce a file exactly.
+pub fn features_to_joints_with_final(features: &[FeatureFrame]) -> Vec<Pose> {
+    let mut poses = features_to_joints(features);
+    if let (Some(row), Some(last)) = (features.last(), poses.last().copied()) {
+        let (rots, _) = recover_root(features);
+        let inv = rots[rots.len() - 1].inv();
+        let next = std::array::from_fn(|j| {
+            let c = VELOCITIES.start + j * 3;
+            let v = inv.rotate([row[c] as f64, row[c + 1] as f64, row[c + 2] as f64]);
+            geom::add(last[j], v)
+        });
+        poses.push(next);
+    }
+    poses
+}
+
+/// Mirrors features left/right: the same as computing features of the mirrored joints
+/// (X negated, left and right swapped). Applying it twice is the identity.
+pub fn mirror_features(features: &[FeatureFrame]) -> Features {
+    features
+        .iter()
+        .map(|row| {
+            let mut out = *row;
+            out[0] = -row[0];
+            out[1] = -row[1];
+            for j in 1..NUM_JOINTS {
+                let m = skeleton::mirror_joint(j);
+                let (src, dst) = (POSITIONS.start + (j - 1) * 3, POSITIONS.start + (m - 1) * 3);
+                out[dst] = -row[src];
+                out[dst + 1] = row[src + 1];
+                out[dst + 2] = row[src + 2];
+                // A rotation matrix M mirrors to S·M·S with S = diag(−1, 1, 1).
+                let (src, dst) = (ROTATIONS.start + (j - 1) * 6, ROTATIONS.start + (m - 1) * 6);
+                let signs = [1.0, -1.0, -1.0, -1.0, 1.0, 1.0];
+                for k in 0..6 {
+                    out[dst + k] = row[src + k] * signs[k];
+                }
+            }
+            for j in 0..NUM_JOINTS {
+                let m = skeleton::mirror_joint(j);
+                let (src, dst) = (VELOCITIES.start + j * 3, VELOCITIES.start + m * 3);
+                out[dst] = -row[src];
+                out[dst + 1] = row[src + 1];
+                out[dst + 2] = row[src + 2];
+            }
+            let c = CONTACTS.start;
+            out[c..c + 2].copy_from_slice(&row[c + 2..c + 4]);
+            out[c + 2..c + 4].copy_from_slice(&row[c..c + 2]);
+            out
+        })
+        .collect()
+}
+
+/// Per-column mean and standard deviation of features over a training set; models see
+/// `(x − mean) / std`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Normalizer {
+    pub mean: Vec<f32>,
+    pub std: Vec<f32>,
+}
+
+impl Normalizer {
+    /// Statistics of the given motions. As in HumanML3D, each feature group's standard
+    /// deviation is replaced by the group's average, so no single column dominates the loss;
+    /// a floor keeps constant columns (such as contacts that never change) from dividing by 0.
+    pub fn fit<'a>(motions: impl IntoIterator<Item = &'a [FeatureFrame]>) -> Normalizer {
+        let mut n = 0f64;
+        let mut sum = vec![0f64; FEATURE_DIM];
+        let mut sq = vec![0f64; FEATURE_DIM];
+        for m in motions {
+            for row in m {
+                n += 1.0;
+                for (k, v) in row.iter().enumerate() {
+                    sum[k] += *v as f64;
+                    sq[k] += (*v as f64) * (*v as f64);
+                }
+            }
+        }
+        let n = n.max(1.0);
+        let mean: Vec<f64> = sum.iter().map(|s| s / n).collect();
+        let var: Vec<f64> = sq
+            .iter()
+            .zip(&mean)
+            .map(|(s, m)| (s / n - m * m).max(0.0))
+            .collect();
+        let mut std = vec![0f64; FEATURE_DIM];
+        for (_, range) in GROUPS {
+            let avg = range.clone().map(|k| var[k].sqrt()).sum::<f64>() / range.len() as f64;
+            for k in range {
+                std[k] = avg.max(1e-6);
+            }
+        }
+        Normalizer {
+            mean: mean.iter().map(|v| *v as f32).collect(),
+            std: std.iter().map(|v| *v as f32).collect(),
+        }
+    }
+
+    /// Reads `Mean.npy` and `Std.npy` (each of shape (263,)).
+    pub fn read(
+        mean: impl AsRef<std::path::Path>,
+        std: impl AsRef<std::path::Path>,
+    ) -> Result<Normalizer, NpyError> {
+        let m = NpyArray::read(mean)?;
+        let s = NpyArray::read(std)?;
+        m.expect_shape(&[Some(FEATURE_DIM)])?;
+        s.expect_shape(&[Some(FEATURE_DIM)])?;
+        Ok(Normalizer {
+            mean: m.data.iter().map(|v| *v as f32).collect(),
+            std: s.data.iter().map(|v| *v as f32).collect(),
+        })
+    }
+
+    /// `(x − mean) / std`, row by row.
+    pub fn normalize(&self, features: &[FeatureFrame]) -> Features {
+        features
+            .iter()
+            .map(|row| std::array::from_fn(|k| (row[k] - self.mean[k]) / self.std[k]))
+            .collect()
+    }
+
+    /// `x · std + mean`, row by row.
+    pub fn denormalize(&self, features: &[FeatureFrame]) -> Features {
+        features
+            .iter()
+            .map(|row| std::array::from_fn(|k| row[k] * self.std[k] + self.mean[k]))
+            .collect()
+    }
+}
+
+/// Features as a (T, 263) array for `.npy` export.
+pub fn features_to_npy(features: &[FeatureFrame]) -> NpyArray {
+    NpyArray::new(
+        vec![features.len(), FEATURE_DIM],
+        features.iter().flatten().map(|v| *v as f64).collect(),
+    )
+}
+
+/// Features from a (T, 263) array.
+pub fn features_from_npy(array: &NpyArray) -> Result<Features, FeatureError> {
+    array.expect_shape(&[None, Some(FEATURE_DIM)])?;
+    Ok(array
+        .data
+        .chunks_exact(FEATURE_DIM)
+        .map(|c| std::array::from_fn(|k| c[k] as f32))
+        .collect())
+}
+
+/// Joint positions as a (T, 22, 3) array.
+pub fn joints_to_npy(poses: &[Pose]) -> NpyArray {
+    NpyArray::new(
+        vec![poses.len(), NUM_JOINTS, 3],
+        poses.iter().flatten().flatten().copied().collect(),
+    )
+}
+
+/// Joint positions from a (T, 22, 3) array; wider skeletons (such as the 52 SMPL-H joints)
+/// keep their first 22 joints.
+pub fn joints_from_npy(array: &NpyArray) -> Result<Vec<Pose>, FeatureError> {
+    let (frames, joints) = match array.shape.as_slice() {
+        [t, j, 3] if *j >= NUM_JOINTS => (*t, *j),
+        [j, 3] if *j >= NUM_JOINTS => (1, *j),
+        _ => {
+            return Err(NpyError::Shape {
+                expected: "(T, 22, 3)".into(),
+                found: array.shape.clone(),
+            }
+            .into())
+        }
+    };
+    Ok((0..frames)
+        .map(|t| {
+            std::array::from_fn(|j| {
+                let c = (t * joints + j) * 3;
+                [array.data[c], array.data[c + 1], array.data[c + 2]]
+            })
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A synthetic walk-like motion: the root moves forward and turns slowly while the arms
+    /// swing, on a skeleton with rest-direction bones.
+    fn synthetic(frames: usize) -> Vec<Pose> {
+        let offsets = Offsets(skeleton::RAW_OFFSETS.map(|d| geom::scale(d, 0.15)));
+        let rots: Vec<_> = (0..frames)
+            .map(|t| {
+                let s = (t as f64 * 0.3).sin();
+                let mut r = [Quat::IDENTITY; NUM_JOINTS];
+                r[0] = Quat::from_yaw(0.02 * t as f64 + 0.5);
+                r[joint::L_SHOULDER] = Quat::from_axis_angle([1.0, 0.0, 0.0], 0.6 * s);
+                r[joint::R_SHOULDER] = Quat::from_axis_angle([1.0, 0.0, 0.0], -0.6 * s);
+                r[joint::L_HIP] = Quat::from_axis_angle([1.0, 0.0, 0.0], -0.4 * s);
+                r[joint::R_HIP] = Quat::from_axis_angle([1.0, 0.0, 0.0], 0.4 * s);
+                r
+            })
+            .collect();
+        let root: Vec<Vec3> = (0..frames).map(|t| [0.3, 0.9, 0.05 * t as f64]).collect();
+        skeleton::forward_kinematics(&rots, &offsets, &root)
+    }
+
+    #[test]
+    fn features_have_shape_and_round_trip_to_joints() {
+        let poses = synthetic(40);
+        let target = Offsets::from_pose(&poses[0]);
+        let (feats, global) = joints_to_features(&poses, &target).unwrap();
+        assert_eq!(feats.len(), 39);
+        let back = features_to_joints(&feats);
+        for t in 0..feats.len() {
+            for j in 0..NUM_JOINTS {
+                assert!(
+                    geom::dist(back[t][j], global[t][j]) < 1e-5,
+                    "frame {t} joint {j}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn mirrored_features_match_features_of_mirrored_joints() {
+        let poses = synthetic(30);
+        let target = Offsets::from_pose(&poses[0]);
+        let (feats, _) = joints_to_features(&poses, &target).unwrap();
+        let (mirrored, _) = joints_to_features(&skeleton::mirror_poses(&poses), &target).unwrap();
+        let direct = mirror_features(&feats);
+        for (a, b) in direct.iter().zip(&mirrored) {
+            for k in 0..FEATURE_DIM {
+                assert!(
+                    (a[k] - b[k]).abs() < 1e-4,
+                    "column {k}: {} vs {}",
+                    a[k],
+                    b[k]
+                );
+            }
+        }
+        assert_eq!(mirror_features(&direct), feats);
+    }
+
+    #[test]
+    fn rejects_short_and_nan_motions() {
+        let target = Offsets(skeleton::RAW_OFFSETS);
+        let one = synthetic(1);
+        assert!(matches!(
+            joints_to_features(&one, &target),
+            Err(FeatureError::TooShort(1))
+        ));
+        let mut bad = synthetic(5);
+        bad[3][4][1] = f64::NAN;
+        assert!(matches!(
+            joints_to_features(&bad, &target),
+            Err(FeatureError::NonFinite(3))
+        ));
+    }
+
+    #[test]
+    fn normalizer_round_trips() {
+        let poses = synthetic(30);
+        let (feats, _) = joints_to_features(&poses, &Offsets::from_pose(&poses[0])).unwrap();
+        let norm = Normalizer::fit([feats.as_slice()]);
+        let back = norm.denormalize(&norm.normalize(&feats));
+        for (a, b) in back.iter().zip(&feats) {
+            for k in 0..FEATURE_DIM {
+                assert!((a[k] - b[k]).abs() < 1e-4);
+            }
+        }
+    }
+}

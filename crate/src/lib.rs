@@ -1,0 +1,13 @@
+//! CoMA in the browser: the core library.
+//!
+//! Motions are 22-joint SMPL skeletons at 20 fps, Y up, metres, starting at the origin facing
+//! +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
+
+// pub mod bvh;
+// pub mod dataset;
+pub mod features;
+pub mod geom;
+pub mod npy;
+// pub mod posecodes;
+// pub mod render;
+pub mod skeleton;
