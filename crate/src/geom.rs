@@ -82,6 +82,8 @@ impl Quat {
     }
 
     /// Hamilton product: the rotation that applies `rhs` first, then `self`.
+    // A named method rather than `*`: the order matters and reads better spelled out.
+    #[allow(clippy::should_implement_trait)]
     pub fn mul(self, rhs: Quat) -> Quat {
         let [aw, ax, ay, az] = self.0;
         let [bw, bx, by, bz] = rhs.0;

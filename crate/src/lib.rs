@@ -3,11 +3,13 @@
 //! Motions are 22-joint SMPL skeletons at 20 fps, Y up, metres, starting at the origin facing
 //! +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
 
-// pub mod bvh;
-// pub mod dataset;
+pub mod bvh;
+pub mod dataset;
 pub mod features;
 pub mod geom;
+pub mod motion_file;
 pub mod npy;
-// pub mod posecodes;
-// pub mod render;
+pub mod posecodes;
+pub mod render;
+pub mod serve;
 pub mod skeleton;

@@ -230,12 +230,47 @@ impl BodyPart {
     }
 }
 
+/// Bone lengths (metres, child from parent) of HumanML3D's reference skeleton
+/// (`skeleton_example_h3d.npy`, first frame), which every motion is rescaled to so that all
+/// data shares one body. Index 0 (the pelvis) has no bone.
+pub const REFERENCE_BONE_LENGTHS: [f64; NUM_JOINTS] = [
+    0.0,
+    0.10307396801404012,
+    0.10988336793155128,
+    0.13156824272391562,
+    0.39362320104637244,
+    0.3901882263567628,
+    0.14319021469648505,
+    0.43243308125288354,
+    0.4256433445515134,
+    0.057364735143330216,
+    0.14338181866410357,
+    0.1494190728208926,
+    0.2193600528916467,
+    0.137486767617009,
+    0.1433828328285533,
+    0.10303921946937832,
+    0.13161404584007272,
+    0.12298437803931866,
+    0.2568400048098033,
+    0.2630917441711329,
+    0.2660117216252147,
+    0.2698764031509594,
+];
+
 /// Bone vectors of a skeleton: for each joint, the offset from its parent in the rest pose
 /// (rest direction × bone length, metres). Joint 0's offset is zero.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Offsets(pub [Vec3; NUM_JOINTS]);
 
 impl Offsets {
+    /// The reference skeleton's bones along the rest directions.
+    pub fn reference() -> Offsets {
+        Offsets(std::array::from_fn(|j| {
+            geom::scale(RAW_OFFSETS[j], REFERENCE_BONE_LENGTHS[j])
+        }))
+    }
+
     /// The offsets of a skeleton whose bone lengths are those of `pose`, along the rest
     /// directions.
     pub fn from_pose(pose: &Pose) -> Offsets {
@@ -389,9 +424,9 @@ mod tests {
         let rots = inverse_kinematics(&[pose, pose], false);
         let offsets = Offsets::from_pose(&pose);
         let back = forward_kinematics(&rots, &offsets, &[pose[0], pose[0]]);
-        for t in 0..2 {
-            for j in 0..NUM_JOINTS {
-                assert!(geom::dist(back[t][j], pose[j]) < 1e-4, "joint {j}");
+        for frame in &back {
+            for (j, (p, q)) in frame.iter().zip(&pose).enumerate() {
+                assert!(geom::dist(*p, *q) < 1e-4, "joint {j}");
             }
         }
     }

@@ -145,8 +145,8 @@ pub fn joints_to_features(
             let six = [m[0][0], m[1][0], m[2][0], m[0][1], m[1][1], m[2][1]];
             row[c..c + 6].copy_from_slice(&six.map(|v| v as f32));
         }
-        for j in 0..NUM_JOINTS {
-            let v = root_rot[t].rotate(geom::sub(global[t + 1][j], global[t][j]));
+        for (j, (next, now)) in global[t + 1].iter().zip(&global[t]).enumerate() {
+            let v = root_rot[t].rotate(geom::sub(*next, *now));
             let c = VELOCITIES.start + j * 3;
             row[c..c + 3].copy_from_slice(&v.map(|v| v as f32));
         }
@@ -258,34 +258,54 @@ pub fn mirror_features(features: &[FeatureFrame]) -> Features {
         .collect()
 }
 
-/// Per-column mean and standard deviation of features over a training set; models see
-/// `(x − mean) / std`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Normalizer {
-    pub mean: Vec<f32>,
-    pub std: Vec<f32>,
+/// Running sums over feature rows, to fit a [`Normalizer`] without keeping the rows.
+#[derive(Clone, Debug)]
+pub struct FeatureStats {
+    rows: f64,
+    sum: Vec<f64>,
+    sum_sq: Vec<f64>,
 }
 
-impl Normalizer {
-    /// Statistics of the given motions. As in HumanML3D, each feature group's standard
-    /// deviation is replaced by the group's average, so no single column dominates the loss;
-    /// a floor keeps constant columns (such as contacts that never change) from dividing by 0.
-    pub fn fit<'a>(motions: impl IntoIterator<Item = &'a [FeatureFrame]>) -> Normalizer {
-        let mut n = 0f64;
-        let mut sum = vec![0f64; FEATURE_DIM];
-        let mut sq = vec![0f64; FEATURE_DIM];
-        for m in motions {
-            for row in m {
-                n += 1.0;
-                for (k, v) in row.iter().enumerate() {
-                    sum[k] += *v as f64;
-                    sq[k] += (*v as f64) * (*v as f64);
-                }
+impl Default for FeatureStats {
+    fn default() -> Self {
+        FeatureStats {
+            rows: 0.0,
+            sum: vec![0.0; FEATURE_DIM],
+            sum_sq: vec![0.0; FEATURE_DIM],
+        }
+    }
+}
+
+impl FeatureStats {
+    /// Adds the rows of one motion.
+    pub fn add(&mut self, motion: &[FeatureFrame]) {
+        for row in motion {
+            self.rows += 1.0;
+            for (k, v) in row.iter().enumerate() {
+                self.sum[k] += *v as f64;
+                self.sum_sq[k] += (*v as f64) * (*v as f64);
             }
         }
-        let n = n.max(1.0);
-        let mean: Vec<f64> = sum.iter().map(|s| s / n).collect();
-        let var: Vec<f64> = sq
+    }
+
+    /// Combines two partial sums.
+    pub fn merge(mut self, other: FeatureStats) -> FeatureStats {
+        self.rows += other.rows;
+        for k in 0..FEATURE_DIM {
+            self.sum[k] += other.sum[k];
+            self.sum_sq[k] += other.sum_sq[k];
+        }
+        self
+    }
+
+    /// Mean per column and, as in HumanML3D, one standard deviation per feature group (the
+    /// group's average), so no single column dominates a loss; a floor keeps constant groups
+    /// from dividing by zero.
+    pub fn finish(&self) -> Normalizer {
+        let n = self.rows.max(1.0);
+        let mean: Vec<f64> = self.sum.iter().map(|s| s / n).collect();
+        let var: Vec<f64> = self
+            .sum_sq
             .iter()
             .zip(&mean)
             .map(|(s, m)| (s / n - m * m).max(0.0))
@@ -301,6 +321,37 @@ impl Normalizer {
             mean: mean.iter().map(|v| *v as f32).collect(),
             std: std.iter().map(|v| *v as f32).collect(),
         }
+    }
+}
+
+/// Per-column mean and standard deviation of features over a training set; models see
+/// `(x − mean) / std`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Normalizer {
+    pub mean: Vec<f32>,
+    pub std: Vec<f32>,
+}
+
+impl Normalizer {
+    /// Statistics of the given motions (see [`FeatureStats::finish`]).
+    pub fn fit<'a>(motions: impl IntoIterator<Item = &'a [FeatureFrame]>) -> Normalizer {
+        let mut stats = FeatureStats::default();
+        for m in motions {
+            stats.add(m);
+        }
+        stats.finish()
+    }
+
+    /// Writes `Mean.npy` and `Std.npy` (each of shape (263,), float32).
+    pub fn write(
+        &self,
+        mean: impl AsRef<std::path::Path>,
+        std: impl AsRef<std::path::Path>,
+    ) -> Result<(), NpyError> {
+        let arr =
+            |v: &[f32]| NpyArray::new(vec![FEATURE_DIM], v.iter().map(|x| *x as f64).collect());
+        arr(&self.mean).write_f32(mean)?;
+        arr(&self.std).write_f32(std)
     }
 
     /// Reads `Mean.npy` and `Std.npy` (each of shape (263,)).

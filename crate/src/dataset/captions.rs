@@ -1,0 +1,295 @@
+//! Global captions of a clip from its content and style labels, worded several ways so the
+//! text encoder sees varied language for the same motion ("a person walks forward tiredly",
+//! "someone walks ahead, looking tired").
+
+/// The label a content becomes when the motion is mirrored left/right.
+pub fn mirror_content(content: &str) -> String {
+    if content.contains("left") {
+        content.replace("left", "right")
+    } else {
+        content.replace("right", "left")
+    }
+}
+
+/// Ways to say what the motion is, third person present, without a subject.
+fn action_phrases(content: &str) -> &'static [&'static str] {
+    match content {
+        "walk" => &[
+            "walks forward",
+            "walks straight ahead",
+            "takes a walk forward",
+            "walks ahead",
+        ],
+        "run" => &["runs forward", "jogs forward", "runs straight ahead"],
+        "dash" => &[
+            "sprints forward",
+            "dashes forward at full speed",
+            "runs fast straight ahead",
+        ],
+        "walk-back" => &[
+            "walks backward",
+            "steps backwards",
+            "walks backwards slowly",
+        ],
+        "walk-left" => &[
+            "walks to the left",
+            "walks towards the left",
+            "moves to the left while walking",
+        ],
+        "walk-right" => &[
+            "walks to the right",
+            "walks towards the right",
+            "moves to the right while walking",
+        ],
+        "walk-turn-left" => &[
+            "walks forward and turns left",
+            "walks and makes a left turn",
+            "walks, turning to the left",
+        ],
+        "walk-turn-right" => &[
+            "walks forward and turns right",
+            "walks and makes a right turn",
+            "walks, turning to the right",
+        ],
+        "bow" => &[
+            "bows",
+            "bows politely",
+            "bends forward at the waist in a bow",
+        ],
+        "bye" => &[
+            "waves goodbye",
+            "waves a hand to say goodbye",
+            "says goodbye with a wave",
+        ],
+        "byebye" => &[
+            "waves goodbye energetically",
+            "waves goodbye with big arm movements",
+            "says bye-bye with a big wave",
+        ],
+        "guide" => &[
+            "gestures with an arm to guide someone",
+            "shows the way with a sweep of the arm",
+            "points the way with an open hand",
+        ],
+        "respond" => &[
+            "responds to someone with a gesture",
+            "answers with a gesture",
+            "reacts to someone with a gesture",
+        ],
+        "call" => &[
+            "calls someone over with a gesture",
+            "beckons someone to come",
+            "calls out to someone, gesturing",
+        ],
+        "punch" => &["punches", "throws punches", "punches forward"],
+        "kick" => &["kicks", "kicks forward with a leg", "throws a kick"],
+        "slash" => &[
+            "slashes as if with a sword",
+            "swings an arm in a slashing motion",
+            "makes a sword slash",
+        ],
+        "dance-long" | "dance-short" => &["dances", "dances energetically", "performs a dance"],
+        "wave-both-hands" => &[
+            "waves both hands",
+            "waves with both hands raised",
+            "waves both arms in greeting",
+        ],
+        "wave-left-hand" => &[
+            "waves the left hand",
+            "waves with the left hand",
+            "raises the left hand and waves",
+        ],
+        "wave-right-hand" => &[
+            "waves the right hand",
+            "waves with the right hand",
+            "raises the right hand and waves",
+        ],
+        "raise-up-both-hands" => &[
+            "raises both hands",
+            "lifts both arms up",
+            "raises both hands above the head",
+        ],
+        "raise-up-left-hand" => &[
+            "raises the left hand",
+            "lifts the left arm up",
+            "raises the left hand up high",
+        ],
+        "raise-up-right-hand" => &[
+            "raises the right hand",
+            "lifts the right arm up",
+            "raises the right hand up high",
+        ],
+        _ => &[],
+    }
+}
+
+/// A fallback phrase for content labels we have no wording for: the label's words.
+fn label_phrase(content: &str) -> String {
+    content.replace('-', " ")
+}
+
+/// Style wordings: an adverb or manner phrase placed after the action, and an adjective for
+/// the subject. `None` for the neutral style.
+fn style_words(style: &str) -> Option<(&'static [&'static str], &'static str)> {
+    Some(match style {
+        "normal" => return None,
+        "happy" => (&["happily", "in a happy way", "cheerfully"], "happy"),
+        "sad" => (&["sadly", "in a sad way", "looking sad"], "sad"),
+        "angry" => (&["angrily", "in an angry way", "looking angry"], "angry"),
+        "proud" => (
+            &["proudly", "in a proud way", "with a proud posture"],
+            "proud",
+        ),
+        "not-confident" => (
+            &["timidly", "without confidence", "in an unsure way"],
+            "timid",
+        ),
+        "masculinity" | "masculine" => (
+            &[
+                "in a masculine way",
+                "with a masculine manner",
+                "in a manly style",
+            ],
+            "masculine",
+        ),
+        "feminine" => (
+            &["in a feminine way", "with a feminine manner", "gracefully"],
+            "feminine",
+        ),
+        "childish" => (
+            &["childishly", "like a child", "in a childlike way"],
+            "childlike",
+        ),
+        "old" | "elderly" => (
+            &[
+                "like an old person",
+                "slowly like an elderly person",
+                "in an elderly way",
+            ],
+            "elderly",
+        ),
+        "tired" | "exhausted" => (
+            &["tiredly", "looking exhausted", "in an exhausted way"],
+            "tired",
+        ),
+        "active" => (
+            &["energetically", "actively", "in a lively way"],
+            "energetic",
+        ),
+        "musical" => (
+            &[
+                "rhythmically, like in a musical",
+                "in a theatrical, musical way",
+                "with musical flair",
+            ],
+            "theatrical",
+        ),
+        "giant" => (
+            &[
+                "heavily like a giant",
+                "with big heavy movements",
+                "like a giant",
+            ],
+            "giant",
+        ),
+        "chimpira" => (
+            &[
+                "like a thug",
+                "in a swaggering thug style",
+                "with a tough swagger",
+            ],
+            "swaggering",
+        ),
+        "youthful" => (
+            &["youthfully", "in a youthful way", "with youthful energy"],
+            "young",
+        ),
+        _ => return None,
+    })
+}
+
+const SUBJECTS: [&str; 4] = ["a person", "someone", "the person", "a human"];
+
+/// A small deterministic hash so every clip gets its own but reproducible choice of words.
+pub fn stable_hash(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+    })
+}
+
+/// `count` distinct global captions for a clip, chosen deterministically from `seed`.
+pub fn global_captions(content: &str, style: &str, seed: &str, count: usize) -> Vec<String> {
+    let fallback = [label_phrase(content)];
+    let actions: Vec<&str> = match action_phrases(content) {
+        [] => fallback.iter().map(String::as_str).collect(),
+        a => a.to_vec(),
+    };
+    let style = style_words(style);
+    let mut candidates = Vec::new();
+    for (i, action) in actions.iter().enumerate() {
+        for (k, subject) in SUBJECTS.iter().enumerate() {
+            match style {
+                None => candidates.push(format!("{subject} {action}")),
+                Some((manners, adjective)) => {
+                    candidates.push(format!(
+                        "{subject} {action} {}",
+                        manners[(i + k) % manners.len()]
+                    ));
+                    if k == 0 {
+                        let article = if adjective.starts_with(['a', 'e', 'i', 'o', 'u']) {
+                            "an"
+                        } else {
+                            "a"
+                        };
+                        candidates.push(format!("{article} {adjective} person {action}"));
+                    }
+                }
+            }
+        }
+    }
+    let mut h = stable_hash(seed);
+    let mut out: Vec<String> = Vec::new();
+    while out.len() < count.min(candidates.len()) {
+        h = h
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let pick = &candidates[(h >> 33) as usize % candidates.len()];
+        if !out.contains(pick) {
+            out.push(pick.clone());
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mirroring_swaps_sides() {
+        assert_eq!(mirror_content("wave-left-hand"), "wave-right-hand");
+        assert_eq!(mirror_content("walk-turn-right"), "walk-turn-left");
+        assert_eq!(mirror_content("bow"), "bow");
+    }
+
+    #[test]
+    fn captions_are_distinct_deterministic_and_on_topic() {
+        let a = global_captions("wave-left-hand", "tired", "clip_001", 4);
+        assert_eq!(a.len(), 4);
+        assert_eq!(a, global_captions("wave-left-hand", "tired", "clip_001", 4));
+        let mut sorted = a.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), 4);
+        assert!(
+            a.iter().all(|c| c.contains("left") && !c.contains("right")),
+            "{a:?}"
+        );
+    }
+
+    #[test]
+    fn unknown_labels_still_get_words() {
+        let c = global_captions("cartwheel", "normal", "x", 2);
+        assert!(c.iter().all(|c| c.contains("cartwheel")), "{c:?}");
+    }
+}

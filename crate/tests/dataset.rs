@@ -1,0 +1,140 @@
+//! The dataset builder on a spread of real Bandai-Namco clips.
+
+use coma::dataset::{build, BuildOptions};
+use coma::features::{self, Normalizer, FEATURE_DIM};
+use coma::npy::NpyArray;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+#[test]
+fn small_build_writes_the_humanml3d_layout() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("bandai");
+    let archive =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/bandai-namco-bvh.tar.xz");
+    let lines = std::sync::Mutex::new(Vec::new());
+    let options = BuildOptions {
+        source: archive,
+        out: out.clone(),
+        limit: Some(40),
+    };
+    let summary = build(&options, &|l| lines.lock().unwrap().push(l.to_string())).unwrap();
+    assert!(
+        lines.lock().unwrap().iter().any(|l| l.contains("ETA")),
+        "progress is reported"
+    );
+
+    // Every clip gives at least one item and its mirror.
+    assert_eq!(summary.source_clips, 40);
+    assert!(summary.clips >= 80, "{} items", summary.clips);
+    let names: BTreeSet<String> = summary.items.iter().map(|i| i.name.clone()).collect();
+    for item in summary.items.iter().filter(|i| !i.mirrored) {
+        assert!(
+            names.contains(&format!("M{}", item.name)),
+            "mirror of {}",
+            item.name
+        );
+    }
+
+    // Files of every item, with consistent shapes.
+    for item in &summary.items {
+        let f = NpyArray::read(
+            out.join("new_joint_vecs")
+                .join(format!("{}.npy", item.name)),
+        )
+        .unwrap();
+        assert_eq!(f.shape, vec![item.frames, FEATURE_DIM]);
+        assert!(item.frames <= 196 && item.frames >= 20);
+        let j = NpyArray::read(out.join("new_joints").join(format!("{}.npy", item.name))).unwrap();
+        assert_eq!(j.shape, vec![item.frames, 22, 3]);
+        let texts =
+            std::fs::read_to_string(out.join("texts").join(format!("{}.txt", item.name))).unwrap();
+        assert!(texts.lines().count() >= 3);
+        assert!(texts.lines().all(|l| l.split('#').count() == 4), "{texts}");
+        let parts =
+            std::fs::read_to_string(out.join("part_texts").join(format!("{}.txt", item.name)))
+                .unwrap();
+        let heads: Vec<&str> = parts
+            .lines()
+            .map(|l| l.split('#').next().unwrap())
+            .collect();
+        assert_eq!(heads, ["left arm", "left leg", "right arm", "right leg"]);
+    }
+
+    // Splits: disjoint, and every clip in exactly one.
+    let mut split_of_clip: BTreeMap<String, String> = BTreeMap::new();
+    let mut listed = 0;
+    for split in ["train", "val", "test"] {
+        let text = std::fs::read_to_string(out.join(format!("{split}.txt"))).unwrap();
+        for name in text.lines().filter(|l| !l.is_empty()) {
+            listed += 1;
+            let item = summary.items.iter().find(|i| i.name == name).unwrap();
+            let previous = split_of_clip.insert(item.clip.clone(), split.to_string());
+            assert!(
+                previous.is_none_or(|p| p == split),
+                "{} is in two splits",
+                item.clip
+            );
+        }
+    }
+    assert_eq!(listed, summary.clips);
+    assert!(split_of_clip.values().any(|s| s == "test"));
+
+    // Mirrors swap sides in labels and captions.
+    for item in summary
+        .items
+        .iter()
+        .filter(|i| i.mirrored && i.content.contains("left"))
+    {
+        assert!(
+            item.captions.iter().all(|c| !c.contains("right")),
+            "{:?}",
+            item.captions
+        );
+    }
+
+    // Statistics and the summary.
+    let norm = Normalizer::read(out.join("Mean.npy"), out.join("Std.npy")).unwrap();
+    assert!(norm.std.iter().all(|s| *s > 0.0));
+    let first = features::features_from_npy(
+        &NpyArray::read(
+            out.join("new_joint_vecs")
+                .join(format!("{}.npy", summary.items[0].name)),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let z = norm.normalize(&first);
+    assert!(z.iter().flatten().all(|v| v.is_finite()));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("dataset.json")).unwrap()).unwrap();
+    for key in [
+        "clips",
+        "frames",
+        "hours",
+        "captions",
+        "vocabulary",
+        "licence",
+    ] {
+        assert!(json.get(key).is_some(), "dataset.json has {key}");
+    }
+    assert_eq!(json["licence"], "CC BY-NC 4.0");
+    assert!(json["vocabulary"]["words"].as_array().unwrap().len() > 20);
+    assert!(
+        !out.with_extension("partial").exists(),
+        "the partial build was moved into place"
+    );
+}
+
+#[test]
+fn missing_archive_gives_a_clear_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let options = BuildOptions {
+        source: tmp.path().join("nope.tar.xz"),
+        out: tmp.path().join("out"),
+        limit: None,
+    };
+    let err = build(&options, &|_| {}).unwrap_err();
+    assert!(format!("{err:#}").contains("nope.tar.xz"), "{err:#}");
+    assert!(!tmp.path().join("out").exists());
+}

@@ -1,0 +1,25 @@
+# Shared by start.sh and test.sh: installs the tools the build needs, only when missing or at
+# the wrong version, so a machine that already has them starts at once.
+WASM_BINDGEN_VERSION=0.2.130
+
+ensure_rust_tools() {
+  rustup component list --installed 2>/dev/null | grep -q '^clippy' || rustup component add clippy
+  rustup component list --installed 2>/dev/null | grep -q '^rustfmt' || rustup component add rustfmt
+  rustup target list --installed | grep -qx wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
+  if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $WASM_BINDGEN_VERSION" ]; then
+    echo "installing wasm-bindgen-cli $WASM_BINDGEN_VERSION (a few minutes, once)"
+    # Without --locked: its lock file names a crate version the registry no longer serves.
+    cargo install wasm-bindgen-cli --version "$WASM_BINDGEN_VERSION"
+  fi
+}
+
+# Builds the page into dist/: the wasm module, its JS glue, index.html and static/.
+build_page() {
+  local target_dir="${CARGO_TARGET_DIR:-target}"
+  cargo build --release -p coma-web --target wasm32-unknown-unknown
+  rm -rf dist && mkdir -p dist/pkg
+  wasm-bindgen --target web --no-typescript --out-dir dist/pkg \
+    "$target_dir/wasm32-unknown-unknown/release/coma_web.wasm"
+  cp index.html dist/
+  cp -r static dist/static
+}
