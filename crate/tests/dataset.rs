@@ -6,6 +6,10 @@ use coma::npy::NpyArray;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
+fn archive() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/bandai-namco-bvh.tar.xz")
+}
+
 #[test]
 fn small_build_writes_the_humanml3d_layout() {
     let tmp = tempfile::tempdir().unwrap();
@@ -124,6 +128,36 @@ fn small_build_writes_the_humanml3d_layout() {
         !out.with_extension("partial").exists(),
         "the partial build was moved into place"
     );
+}
+
+#[test]
+fn full_build_has_enough_clips_and_hours() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("bandai");
+    let options = BuildOptions {
+        source: archive(),
+        out: out.clone(),
+        limit: None,
+    };
+    let summary = build(&options, &|_| {}).unwrap();
+    assert_eq!(summary.source_clips, 3076);
+    assert!(summary.clips >= 5800, "{} clips", summary.clips);
+    assert!(summary.hours >= 7.0, "{:.2} hours", summary.hours);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("dataset.json")).unwrap()).unwrap();
+    assert_eq!(json["clips"].as_u64().unwrap() as usize, summary.clips);
+    let actions = json["vocabulary"]["actions"].as_object().unwrap();
+    for action in [
+        "walk",
+        "bow",
+        "wave-left-hand",
+        "wave-right-hand",
+        "raise-up-left-hand",
+        "run",
+        "kick",
+    ] {
+        assert!(actions.contains_key(action), "vocabulary has {action}");
+    }
 }
 
 #[test]

@@ -221,8 +221,10 @@ pub fn features_to_joints_with_final(features: &[FeatureFrame]) -> Vec<Pose> {
     poses
 }
 
-/// Mirrors features left/right: the same as computing features of the mirrored joints
-/// (X negated, left and right swapped). Applying it twice is the identity.
+/// Mirrors features left/right: the result describes exactly the mirrored joints (X negated,
+/// left and right swapped) on the same body. Applying it twice is the identity. (Computing
+/// features from mirrored joints gives slightly different numbers, because the reference
+/// skeleton's left and right bones differ in length by a few millimetres.)
 pub fn mirror_features(features: &[FeatureFrame]) -> Features {
     features
         .iter()
