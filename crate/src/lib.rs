@@ -11,5 +11,8 @@ pub mod motion_file;
 pub mod npy;
 pub mod posecodes;
 pub mod render;
+pub mod rng;
 pub mod serve;
 pub mod skeleton;
+pub mod text;
+pub mod train;

@@ -1,0 +1,4 @@
+//! Text: the WordPiece tokenizer and (next) the all-MiniLM-L6-v2 sentence encoder whose
+//! embeddings condition the motion model.
+
+pub mod tokenizer;

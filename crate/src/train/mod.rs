@@ -1,0 +1,3 @@
+//! Training: data in memory and (next) the training loops of the motion model.
+
+pub mod motions;
