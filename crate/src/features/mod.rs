@@ -202,6 +202,33 @@ pub fn features_to_joints(features: &[FeatureFrame]) -> Vec<Pose> {
         .collect()
 }
 
+/// The feature columns a body part's encoder sees: the root-relative position, 6D rotation
+/// and velocity of each of the part's joints; the legs also see the root features (columns
+/// 0–3), the pelvis velocity and their own foot contacts. Parts overlap as their joints do.
+pub fn part_columns(part: crate::skeleton::BodyPart) -> Vec<usize> {
+    use crate::skeleton::BodyPart;
+    let mut cols = Vec::new();
+    let legs = matches!(part, BodyPart::LeftLeg | BodyPart::RightLeg);
+    if legs {
+        cols.extend(0..4);
+    }
+    let mut joints = part.joints().to_vec();
+    joints.sort_unstable();
+    for j in joints {
+        if j > 0 {
+            cols.extend(POSITIONS.start + (j - 1) * 3..POSITIONS.start + j * 3);
+            cols.extend(ROTATIONS.start + (j - 1) * 6..ROTATIONS.start + j * 6);
+        }
+        cols.extend(VELOCITIES.start + j * 3..VELOCITIES.start + (j + 1) * 3);
+    }
+    match part {
+        BodyPart::LeftLeg => cols.extend([CONTACTS.start, CONTACTS.start + 1]),
+        BodyPart::RightLeg => cols.extend([CONTACTS.start + 2, CONTACTS.start + 3]),
+        _ => {}
+    }
+    cols
+}
+
 /// Every pose the features describe: `T − 1` rows describe `T` frames, and the last one is
 /// reached by adding the last row's joint velocities (stored in the facing frame) to the
 /// last recovered pose. Feature code that smooths over time needs that final frame to
@@ -497,6 +524,23 @@ mod tests {
             }
         }
         assert_eq!(mirror_features(&direct), feats);
+    }
+
+    #[test]
+    fn part_columns_cover_every_feature() {
+        use crate::skeleton::BodyPart;
+        let sizes: Vec<usize> = BodyPart::ALL
+            .iter()
+            .map(|p| part_columns(*p).len())
+            .collect();
+        assert_eq!(sizes, [108, 108, 57, 57]);
+        let mut all: Vec<usize> = BodyPart::ALL
+            .iter()
+            .flat_map(|p| part_columns(*p))
+            .collect();
+        all.sort_unstable();
+        all.dedup();
+        assert_eq!(all, (0..FEATURE_DIM).collect::<Vec<_>>());
     }
 
     #[test]

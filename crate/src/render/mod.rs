@@ -15,6 +15,7 @@
 //! the image's right, exactly as your friend's left hand is on your right when you face them.
 
 mod font;
+pub mod plot;
 
 use std::path::{Path, PathBuf};
 

@@ -1,0 +1,309 @@
+//! Generating and editing motions as tokens, with no extra training: every edit masks some
+//! tokens and lets the transformers fill them in, conditioned on the rest.
+//!
+//! - generate: everything masked;
+//! - in-between: the steps covering frames α..β masked in all parts;
+//! - body part: every step of the chosen parts masked, plus a few random tokens of the others
+//!   so the joins stay natural;
+//! - blend: two motions joined with a masked transition between the end of one and the start
+//!   of the next.
+
+use super::generate::{KeepResidual, MotionTokens, SamplingOptions};
+use super::transformer::{PARTS, TEXT_DIM};
+use super::vq::DOWNSAMPLE;
+use super::Spam;
+use crate::features::{FeatureFrame, FEATURE_DIM};
+use crate::rng::Rng;
+use crate::skeleton::BodyPart;
+use burn::prelude::*;
+use burn::tensor::{Int, TensorData};
+
+/// The text condition of each part (model order: left arm, right arm, left leg, right leg).
+pub type PartText = [[f32; TEXT_DIM]; PARTS];
+
+/// Fraction of the other parts' tokens re-generated in a body-part edit.
+pub const PART_EDIT_CONTEXT: f32 = 0.1;
+
+/// Time steps (of 4 frames) needed for `frames` frames, within the model's range.
+pub fn steps_for_frames(frames: usize, max_steps: usize) -> usize {
+    (frames.div_ceil(DOWNSAMPLE)).clamp(1, max_steps)
+}
+
+impl Spam {
+    /// Fills the masked base positions, then the residual layers, keeping what is fixed.
+    fn fill(
+        &self,
+        text: &PartText,
+        original: Option<&MotionTokens>,
+        editable: &[Vec<bool>],
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let mut rng = Rng::new(options.seed);
+        let fixed: Vec<Vec<Option<u32>>> = editable
+            .iter()
+            .enumerate()
+            .map(|(p, row)| {
+                row.iter()
+                    .enumerate()
+                    .map(|(s, e)| {
+                        if *e {
+                            None
+                        } else {
+                            original.map(|o| o[p][0][s])
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let base = self.decode_base(text, &fixed, options, &mut rng);
+        let keep = original.map(|tokens| KeepResidual { tokens, editable });
+        self.decode_residual(text, base, keep, options, &mut rng)
+    }
+
+    /// A new motion of about `frames` frames (a multiple of 4, at most the model's maximum).
+    pub fn generate(
+        &self,
+        text: &PartText,
+        frames: usize,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let n = steps_for_frames(frames, self.base_config.max_steps - 1);
+        self.fill(text, None, &vec![vec![true; n]; PARTS], options)
+    }
+
+    /// Regenerates frames `from..to` of every part.
+    pub fn inbetween(
+        &self,
+        tokens: &MotionTokens,
+        text: &PartText,
+        from: usize,
+        to: usize,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let n = tokens[0][0].len();
+        let (a, b) = (from / DOWNSAMPLE, to.div_ceil(DOWNSAMPLE).min(n));
+        let editable: Vec<Vec<bool>> = (0..PARTS)
+            .map(|_| (0..n).map(|s| s >= a && s < b).collect())
+            .collect();
+        self.fill(text, Some(tokens), &editable, options)
+    }
+
+    /// Regenerates the chosen parts from their new text (other parts keep their text).
+    pub fn edit_parts(
+        &self,
+        tokens: &MotionTokens,
+        text: &PartText,
+        parts: &[BodyPart],
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let n = tokens[0][0].len();
+        let mut rng = Rng::new(options.seed ^ 0x5EED);
+        let editable: Vec<Vec<bool>> = BodyPart::ALL
+            .iter()
+            .map(|p| {
+                let chosen = parts.contains(p);
+                (0..n)
+                    .map(|_| chosen || rng.uniform() < PART_EDIT_CONTEXT)
+                    .collect()
+            })
+            .collect();
+        self.fill(text, Some(tokens), &editable, options)
+    }
+
+    /// Joins `a` then `b`: the last `overlap` steps of `a` and the first `overlap` of `b` are
+    /// regenerated as a transition, conditioned on both sides (text: the mean of the two).
+    pub fn blend(
+        &self,
+        a: &MotionTokens,
+        b: &MotionTokens,
+        text_a: &PartText,
+        text_b: &PartText,
+        overlap: usize,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let (na, nb) = (a[0][0].len(), b[0][0].len());
+        let ov_a = overlap.min(na / 2);
+        let ov_b = overlap.min(nb / 2);
+        // The transition window: a bit of context from each side around the masked steps.
+        let context = 6usize;
+        let start_a = na.saturating_sub(ov_a + context);
+        let end_b = (ov_b + context).min(nb);
+        let layers = a[0].len();
+        let joined: MotionTokens = (0..PARTS)
+            .map(|p| {
+                (0..layers)
+                    .map(|l| {
+                        a[p][l][start_a..]
+                            .iter()
+                            .chain(&b[p][l][..end_b])
+                            .copied()
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        let w = joined[0][0].len();
+        let (mask_from, mask_to) = (na - start_a - ov_a, na - start_a + ov_b);
+        let editable: Vec<Vec<bool>> = (0..PARTS)
+            .map(|_| (0..w).map(|s| s >= mask_from && s < mask_to).collect())
+            .collect();
+        let text: PartText = std::array::from_fn(|p| {
+            let mut v: [f32; TEXT_DIM] = std::array::from_fn(|i| text_a[p][i] + text_b[p][i]);
+            let norm = v.iter().map(|x| x * x).sum::<f32>().sqrt().max(1e-6);
+            v.iter_mut().for_each(|x| *x /= norm);
+            v
+        });
+        let window = self.fill(&text, Some(&joined), &editable, options);
+        (0..PARTS)
+            .map(|p| {
+                (0..layers)
+                    .map(|l| {
+                        let mut row: Vec<u32> = a[p][l][..start_a].to_vec();
+                        row.extend(&window[p][l]);
+                        row.extend(&b[p][l][end_b..]);
+                        row
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Normalised features of tokens (`4 × steps` frames).
+    pub fn decode(&self, tokens: &MotionTokens) -> Vec<FeatureFrame> {
+        let n = tokens[0][0].len();
+        let parts = tokens
+            .iter()
+            .map(|layers| {
+                layers
+                    .iter()
+                    .map(|row| {
+                        let ids: Vec<i32> = row.iter().map(|t| *t as i32).collect();
+                        Tensor::<2, Int>::from_data(TensorData::new(ids, [1, n]), &self.device)
+                    })
+                    .collect()
+            })
+            .collect();
+        let out: Vec<f32> = self
+            .vq
+            .decode(&parts)
+            .try_into_vec_as::<f32>()
+            .expect("float features");
+        out.chunks_exact(FEATURE_DIM)
+            .map(|c| c.try_into().expect("263 columns"))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::generate::tests::{small, tiny_vq};
+
+    fn spam() -> Spam {
+        Spam::random(&tiny_vq(), &small(), &small(), &Device::flex())
+    }
+
+    #[test]
+    fn generated_length_follows_the_request() {
+        let s = spam();
+        let text = [[0.05f32; TEXT_DIM]; PARTS];
+        for frames in [40, 42, 120] {
+            let tokens = s.generate(&text, frames, &SamplingOptions::default());
+            let got = s.decode(&tokens).len();
+            assert!(
+                (got as i64 - frames as i64).abs() <= 4,
+                "asked {frames}, got {got}"
+            );
+        }
+    }
+
+    #[test]
+    fn inbetween_keeps_everything_outside_the_range() {
+        let s = spam();
+        let text = [[0.05f32; TEXT_DIM]; PARTS];
+        let original = s.generate(
+            &text,
+            48,
+            &SamplingOptions {
+                seed: 1,
+                ..Default::default()
+            },
+        );
+        let edited = s.inbetween(
+            &original,
+            &[[0.3f32; TEXT_DIM]; PARTS],
+            16,
+            32,
+            &SamplingOptions {
+                seed: 2,
+                ..Default::default()
+            },
+        );
+        for p in 0..PARTS {
+            for l in 0..original[p].len() {
+                assert_eq!(original[p][l][..4], edited[p][l][..4]);
+                assert_eq!(original[p][l][8..], edited[p][l][8..]);
+            }
+        }
+    }
+
+    #[test]
+    fn part_edit_mostly_keeps_the_other_parts() {
+        let s = spam();
+        let text = [[0.05f32; TEXT_DIM]; PARTS];
+        let original = s.generate(
+            &text,
+            160,
+            &SamplingOptions {
+                seed: 1,
+                ..Default::default()
+            },
+        );
+        let edited = s.edit_parts(
+            &original,
+            &text,
+            &[BodyPart::LeftArm],
+            &SamplingOptions {
+                seed: 3,
+                ..Default::default()
+            },
+        );
+        let n = original[0][0].len();
+        let same = (0..n)
+            .filter(|&i| original[3][0][i] == edited[3][0][i])
+            .count();
+        assert!(
+            same as f32 >= 0.75 * n as f32,
+            "right leg kept {same} of {n} base tokens"
+        );
+    }
+
+    #[test]
+    fn blend_joins_lengths() {
+        let s = spam();
+        let text = [[0.05f32; TEXT_DIM]; PARTS];
+        let a = s.generate(
+            &text,
+            64,
+            &SamplingOptions {
+                seed: 1,
+                ..Default::default()
+            },
+        );
+        let b = s.generate(
+            &text,
+            80,
+            &SamplingOptions {
+                seed: 2,
+                ..Default::default()
+            },
+        );
+        let joined = s.blend(&a, &b, &text, &text, 2, &SamplingOptions::default());
+        assert_eq!(joined[0][0].len(), 16 + 20);
+        assert_eq!(joined[1][0][..5], a[1][0][..5]);
+        assert_eq!(
+            joined[2][2][joined[2][2].len() - 5..],
+            b[2][2][b[2][2].len() - 5..]
+        );
+    }
+}

@@ -1,0 +1,591 @@
+//! The spatially-aware residual VQ-VAE of SPAM: four body-part encoders, four residual
+//! quantizers and one shared decoder. It turns motion features into discrete tokens (four
+//! parts × `layers` codebooks × T/4 time steps) and tokens back into features.
+//!
+//! ```text
+//!  features [B, T, 263] (normalised, 20 fps)
+//!     │ per part: its columns (108 arm / 57 leg)
+//!     ├──► PartEncoder ─► [B, D, T/4] ─► ResidualQuantizer ─► Σ code vectors [B, D, T/4]   ×4 parts
+//!     │                                        └─► tokens [B, layers, T/4]
+//!     └──► concat the four parts on channels [B, 4D, T/4] ─► Decoder ─► [B, T, 263]
+//! ```
+//!
+//! Model code is written once against burn's run-time `Device`: the same module trains on an
+//! autodiff CPU device and runs inference on WebGPU or CPU.
+
+use crate::features::{part_columns, FEATURE_DIM};
+use crate::rng::Rng;
+use crate::skeleton::BodyPart;
+use burn::module::Param;
+use burn::nn::conv::{Conv1d, Conv1dConfig};
+use burn::nn::PaddingConfig1d;
+use burn::prelude::*;
+use burn::tensor::activation::relu;
+use burn::tensor::{Distribution, Int, TensorData};
+
+/// Temporal downsampling of the encoders: one token per 4 frames (0.2 s).
+pub const DOWNSAMPLE: usize = 4;
+
+/// Sizes and training constants of the VQ-VAE.
+#[derive(Config, Debug)]
+pub struct VqConfig {
+    /// Channels of each part encoder.
+    #[config(default = 128)]
+    pub encoder_width: usize,
+    /// Channels of the shared decoder.
+    #[config(default = 256)]
+    pub decoder_width: usize,
+    /// Dimension of a code vector.
+    #[config(default = 64)]
+    pub code_dim: usize,
+    /// Codes per codebook (at most 512, so a token fits in 9 bits).
+    #[config(default = 256)]
+    pub codebook_size: usize,
+    /// Quantizer layers per part: one base layer and `layers − 1` residual layers.
+    #[config(default = 4)]
+    pub layers: usize,
+    /// Residual blocks per resolution level.
+    #[config(default = 2)]
+    pub res_blocks: usize,
+    /// Probability that a training batch uses only a random number of the first layers.
+    #[config(default = 0.2)]
+    pub quantize_dropout: f64,
+    /// Decay of the codebooks' exponential moving averages.
+    #[config(default = 0.99)]
+    pub ema_decay: f64,
+}
+
+/// A residual block: two convolutions around a ReLU, added to the input.
+#[derive(Module, Debug)]
+pub struct ResBlock {
+    dilated: Conv1d,
+    pointwise: Conv1d,
+}
+
+impl ResBlock {
+    fn new(width: usize, dilation: usize, device: &Device) -> ResBlock {
+        ResBlock {
+            dilated: Conv1dConfig::new(width, width, 3)
+                .with_dilation(dilation)
+                .with_padding(PaddingConfig1d::Explicit(dilation, dilation))
+                .init(device),
+            pointwise: Conv1dConfig::new(width, width, 1).init(device),
+        }
+    }
+
+    /// `[B, C, T] → [B, C, T]`.
+    pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
+        let h = self.dilated.forward(relu(x.clone()));
+        x + self.pointwise.forward(relu(h))
+    }
+}
+
+fn conv3(c_in: usize, c_out: usize, device: &Device) -> Conv1d {
+    Conv1dConfig::new(c_in, c_out, 3)
+        .with_padding(PaddingConfig1d::Explicit(1, 1))
+        .init(device)
+}
+
+/// Residual blocks with growing dilation (1, 3, 9, …) so the receptive field spans seconds.
+fn res_stack(width: usize, count: usize, device: &Device) -> Vec<ResBlock> {
+    (0..count)
+        .map(|i| ResBlock::new(width, 3usize.pow(i as u32), device))
+        .collect()
+}
+
+/// One halving of the time axis, then residual blocks.
+#[derive(Module, Debug)]
+pub struct DownLevel {
+    down: Conv1d,
+    blocks: Vec<ResBlock>,
+}
+
+/// Encoder of one body part: `[B, C_part, T] → [B, D, T/4]`.
+#[derive(Module, Debug)]
+pub struct PartEncoder {
+    input: Conv1d,
+    levels: Vec<DownLevel>,
+    output: Conv1d,
+}
+
+impl PartEncoder {
+    fn new(c_in: usize, config: &VqConfig, device: &Device) -> PartEncoder {
+        let w = config.encoder_width;
+        PartEncoder {
+            input: conv3(c_in, w, device),
+            levels: (0..2)
+                .map(|_| DownLevel {
+                    down: Conv1dConfig::new(w, w, 4)
+                        .with_stride(2)
+                        .with_padding(PaddingConfig1d::Explicit(1, 1))
+                        .init(device),
+                    blocks: res_stack(w, config.res_blocks, device),
+                })
+                .collect(),
+            output: conv3(w, config.code_dim, device),
+        }
+    }
+
+    /// `[B, C_part, T] → [B, D, T/4]`.
+    pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
+        let mut h = relu(self.input.forward(x));
+        for level in &self.levels {
+            h = level.down.forward(h);
+            for block in &level.blocks {
+                h = block.forward(h);
+            }
+        }
+        self.output.forward(h)
+    }
+}
+
+/// Residual blocks, then a doubling of the time axis.
+#[derive(Module, Debug)]
+pub struct UpLevel {
+    blocks: Vec<ResBlock>,
+    conv: Conv1d,
+}
+
+/// The shared decoder: `[B, 4D, T/4] → [B, 263, T]`.
+#[derive(Module, Debug)]
+pub struct Decoder {
+    input: Conv1d,
+    levels: Vec<UpLevel>,
+    hidden: Conv1d,
+    output: Conv1d,
+}
+
+impl Decoder {
+    fn new(config: &VqConfig, device: &Device) -> Decoder {
+        let w = config.decoder_width;
+        Decoder {
+            input: conv3(4 * config.code_dim, w, device),
+            levels: (0..2)
+                .map(|_| UpLevel {
+                    blocks: res_stack(w, config.res_blocks, device),
+                    conv: conv3(w, w, device),
+                })
+                .collect(),
+            hidden: conv3(w, w, device),
+            output: conv3(w, FEATURE_DIM, device),
+        }
+    }
+
+    /// `[B, 4D, N] → [B, 263, 4N]`.
+    pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
+        let mut h = relu(self.input.forward(x));
+        for level in &self.levels {
+            for block in &level.blocks {
+                h = block.forward(h);
+            }
+            // Nearest-neighbour doubling: [B, C, N] → [B, C, N, 2] → [B, C, 2N].
+            let [b, c, n] = h.dims();
+            h = h
+                .unsqueeze_dim::<4>(3)
+                .repeat_dim(3, 2)
+                .reshape([b, c, 2 * n]);
+            h = level.conv.forward(h);
+        }
+        self.output.forward(relu(self.hidden.forward(h)))
+    }
+}
+
+/// One part's residual quantizer: `layers` codebooks of `codebook_size` vectors of `code_dim`,
+/// updated by exponential moving averages (not by gradients), each quantizing what the
+/// previous layers left.
+#[derive(Module, Debug)]
+pub struct ResidualQuantizer {
+    /// `[layers, K, D]` code vectors.
+    pub codebooks: Param<Tensor<3>>,
+    /// `[layers, K]` moving average of how many vectors each code received.
+    ema_counts: Param<Tensor<2>>,
+    /// `[layers, K, D]` moving average of the sum of those vectors.
+    ema_sums: Param<Tensor<3>>,
+}
+
+/// What one layer of a quantizer did in a training step, for the codebook update.
+#[derive(Debug)]
+pub struct LayerAssignment {
+    /// `[M, D]` the vectors this layer quantized (detached).
+    pub residuals: Tensor<2>,
+    /// `[M]` the chosen code of each.
+    pub codes: Tensor<1, Int>,
+}
+
+impl ResidualQuantizer {
+    fn new(config: &VqConfig, device: &Device) -> ResidualQuantizer {
+        let (l, k, d) = (config.layers, config.codebook_size, config.code_dim);
+        ResidualQuantizer {
+            codebooks: Param::from_tensor(Tensor::random(
+                [l, k, d],
+                Distribution::Normal(0.0, 1.0),
+                device,
+            ))
+            .set_require_grad(false),
+            ema_counts: Param::from_tensor(Tensor::zeros([l, k], device)).set_require_grad(false),
+            ema_sums: Param::from_tensor(Tensor::zeros([l, k, d], device)).set_require_grad(false),
+        }
+    }
+
+    /// Codebook `layer` as `[K, D]`.
+    fn codebook(&self, layer: usize) -> Tensor<2> {
+        let [_, k, d] = self.codebooks.val().dims();
+        self.codebooks
+            .val()
+            .slice([layer..layer + 1])
+            .reshape([k, d])
+            .detach()
+    }
+
+    /// Index of the nearest code of each row of `x` (`[M, D]` → `[M]`).
+    fn nearest(x: Tensor<2>, codebook: Tensor<2>) -> Tensor<1, Int> {
+        let x_sq = x.clone().powi_scalar(2).sum_dim(1); // [M, 1]
+        let c_sq = codebook.clone().powi_scalar(2).sum_dim(1).transpose(); // [1, K]
+        let dist = x_sq - x.matmul(codebook.transpose()) * 2.0 + c_sq;
+        let [m, _] = dist.dims();
+        dist.argmin(1).reshape([m])
+    }
+
+    /// Quantizes `z` (`[M, D]`) with the first `active` layers. Returns the summed code
+    /// vectors (no gradient), the codes per layer (`[M]` each) and what each layer saw.
+    pub fn quantize(&self, z: Tensor<2>, active: usize) -> (Tensor<2>, Vec<LayerAssignment>) {
+        let mut residual = z.detach();
+        let mut total = residual.zeros_like();
+        let mut layers = Vec::with_capacity(active);
+        for layer in 0..active {
+            let codebook = self.codebook(layer);
+            let codes = Self::nearest(residual.clone(), codebook.clone());
+            let q = codebook.select(0, codes.clone());
+            layers.push(LayerAssignment {
+                residuals: residual.clone(),
+                codes,
+            });
+            residual = residual - q.clone();
+            total = total + q;
+        }
+        (total, layers)
+    }
+
+    /// Sum of the code vectors of `tokens` (`[layers_used, M]`) → `[M, D]`.
+    pub fn dequantize(&self, tokens: &[Tensor<1, Int>]) -> Tensor<2> {
+        let mut total: Option<Tensor<2>> = None;
+        for (layer, codes) in tokens.iter().enumerate() {
+            let q = self.codebook(layer).select(0, codes.clone());
+            total = Some(match total {
+                None => q,
+                Some(t) => t + q,
+            });
+        }
+        total.expect("at least one token layer")
+    }
+
+    /// Moving-average codebook update from one step's assignments; codes that receive (on
+    /// average) less than one vector are reset to random vectors of this batch, so no code
+    /// stays dead. Returns the number of codes reset.
+    pub fn update(&mut self, assignments: &[LayerAssignment], decay: f64, rng: &mut Rng) -> usize {
+        let [layers, k, d] = self.codebooks.val().dims();
+        let device = self.codebooks.val().device();
+        let mut books = Vec::with_capacity(layers);
+        let mut counts_all = Vec::with_capacity(layers);
+        let mut sums_all = Vec::with_capacity(layers);
+        let mut reset = 0;
+        for layer in 0..layers {
+            let old_counts = self
+                .ema_counts
+                .val()
+                .slice([layer..layer + 1])
+                .reshape([k])
+                .detach();
+            let old_sums = self
+                .ema_sums
+                .val()
+                .slice([layer..layer + 1])
+                .reshape([k, d])
+                .detach();
+            let Some(a) = assignments.get(layer) else {
+                // Layer unused this step (quantization dropout): keep it as it is.
+                books.push(self.codebook(layer));
+                counts_all.push(old_counts);
+                sums_all.push(old_sums);
+                continue;
+            };
+            let [m, _] = a.residuals.dims();
+            let one_hot: Tensor<2> = a.codes.clone().one_hot::<2>(k).float(); // [M, K]
+            let counts = one_hot.clone().sum_dim(0).reshape([k]);
+            let sums = one_hot.transpose().matmul(a.residuals.clone()); // [K, D]
+            let counts = old_counts * decay + counts * (1.0 - decay);
+            let sums = old_sums * decay + sums * (1.0 - decay);
+            let updated = sums.clone() / counts.clone().clamp_min(1e-5).reshape([k, 1]);
+
+            let usage: Vec<f32> = counts.clone().try_into_vec_as::<f32>().unwrap_or_default();
+            let alive: Vec<f32> = usage.iter().map(|c| (*c >= 1.0) as u8 as f32).collect();
+            reset += alive.iter().filter(|a| **a == 0.0).count();
+            let picks: Vec<i32> = (0..k).map(|_| rng.below(m) as i32).collect();
+            let random = a.residuals.clone().select(
+                0,
+                Tensor::<1, Int>::from_data(TensorData::new(picks, [k]), &device),
+            );
+            let alive =
+                Tensor::<1>::from_data(TensorData::new(alive, [k]), &device).reshape([k, 1]);
+            let dead = alive.clone().neg() + 1.0;
+            books.push(updated * alive.clone() + random.clone() * dead.clone());
+            // A reset code starts its averages from the vector it was given.
+            counts_all.push(counts * alive.clone().reshape([k]) + dead.clone().reshape([k]));
+            sums_all.push(sums * alive + random * dead);
+        }
+        let stack3 = |v: Vec<Tensor<2>>| Tensor::stack::<3>(v, 0).detach();
+        let (books, counts, sums) = (
+            stack3(books),
+            Tensor::stack::<2>(counts_all, 0).detach(),
+            stack3(sums_all),
+        );
+        self.codebooks = self.codebooks.clone().map(|_| books);
+        self.ema_counts = self.ema_counts.clone().map(|_| counts);
+        self.ema_sums = self.ema_sums.clone().map(|_| sums);
+        reset
+    }
+}
+
+/// The whole VQ-VAE.
+#[derive(Module, Debug)]
+pub struct MotionVq {
+    encoders: Vec<PartEncoder>,
+    pub quantizers: Vec<ResidualQuantizer>,
+    decoder: Decoder,
+    /// Feature columns of each part, `[4]` index tensors kept as plain data.
+    #[module(skip)]
+    columns: Vec<Vec<usize>>,
+    code_dim: usize,
+    layers: usize,
+}
+
+/// Tokens of a batch of motions: per part (model order), per layer, `[B, N]` codes where
+/// `N = T / 4`.
+pub type PartTokens = Vec<Vec<Tensor<2, Int>>>;
+
+/// Output of a training forward pass.
+#[derive(Debug)]
+pub struct VqTrainOutput {
+    /// `[B, T, 263]` reconstruction.
+    pub reconstruction: Tensor<3>,
+    /// Mean squared distance between encoder outputs and their quantized values.
+    pub commitment: Tensor<1>,
+    /// Per part, what each active layer did (for the codebook update).
+    pub assignments: Vec<Vec<LayerAssignment>>,
+}
+
+impl VqConfig {
+    /// A VQ-VAE with random weights on `device`.
+    pub fn init(&self, device: &Device) -> MotionVq {
+        let columns: Vec<Vec<usize>> = BodyPart::ALL.iter().map(|p| part_columns(*p)).collect();
+        MotionVq {
+            encoders: columns
+                .iter()
+                .map(|c| PartEncoder::new(c.len(), self, device))
+                .collect(),
+            quantizers: (0..4)
+                .map(|_| ResidualQuantizer::new(self, device))
+                .collect(),
+            decoder: Decoder::new(self, device),
+            columns,
+            code_dim: self.code_dim,
+            layers: self.layers,
+        }
+    }
+}
+
+impl MotionVq {
+    /// Quantizer layers per part.
+    pub fn layers(&self) -> usize {
+        self.layers
+    }
+
+    /// Per part, the encoder output `[B, D, T/4]` for `x` `[B, T, 263]` (T a multiple of 4).
+    pub fn encode(&self, x: Tensor<3>) -> Vec<Tensor<3>> {
+        let device = x.device();
+        self.columns
+            .iter()
+            .zip(&self.encoders)
+            .map(|(cols, encoder)| {
+                let idx: Vec<i32> = cols.iter().map(|c| *c as i32).collect();
+                let idx = Tensor::<1, Int>::from_data(TensorData::new(idx, [cols.len()]), &device);
+                encoder.forward(x.clone().select(2, idx).swap_dims(1, 2))
+            })
+            .collect()
+    }
+
+    /// `[B, D, N]` → `[B·N, D]` rows, time-major within each motion.
+    fn rows(z: Tensor<3>) -> Tensor<2> {
+        let [b, d, n] = z.dims();
+        z.swap_dims(1, 2).reshape([b * n, d])
+    }
+
+    /// `[B·N, D]` rows → `[B, D, N]`.
+    fn unrows(q: Tensor<2>, b: usize, n: usize) -> Tensor<3> {
+        let [_, d] = q.dims();
+        q.reshape([b, n, d]).swap_dims(1, 2)
+    }
+
+    /// Training pass: encode, quantize (with quantization dropout drawn from `rng`), decode
+    /// with straight-through gradients.
+    pub fn forward_train(&self, x: Tensor<3>, config: &VqConfig, rng: &mut Rng) -> VqTrainOutput {
+        let active = if (rng.uniform() as f64) < config.quantize_dropout {
+            1 + rng.below(self.layers)
+        } else {
+            self.layers
+        };
+        let mut parts = Vec::with_capacity(4);
+        let mut commitment: Option<Tensor<1>> = None;
+        let mut assignments = Vec::with_capacity(4);
+        for (z, quantizer) in self.encode(x).into_iter().zip(&self.quantizers) {
+            let [b, _, n] = z.dims();
+            let rows = Self::rows(z);
+            let (q, layers) = quantizer.quantize(rows.clone(), active);
+            let c = (rows.clone() - q.clone()).powi_scalar(2).mean();
+            commitment = Some(match commitment {
+                None => c,
+                Some(t) => t + c,
+            });
+            // Straight-through: the decoder sees q, the encoder gets the decoder's gradient.
+            let st = rows.clone() + (q - rows).detach();
+            parts.push(Self::unrows(st, b, n));
+            assignments.push(layers);
+        }
+        let reconstruction = self.decoder.forward(Tensor::cat(parts, 1)).swap_dims(1, 2);
+        VqTrainOutput {
+            reconstruction,
+            commitment: commitment.expect("four parts") / 4.0,
+            assignments,
+        }
+    }
+
+    /// Tokens of `x` `[B, T, 263]` with every layer.
+    pub fn tokenize(&self, x: Tensor<3>) -> PartTokens {
+        self.encode(x)
+            .into_iter()
+            .zip(&self.quantizers)
+            .map(|(z, quantizer)| {
+                let [b, _, n] = z.dims();
+                let (_, layers) = quantizer.quantize(Self::rows(z), self.layers);
+                layers
+                    .into_iter()
+                    .map(|a| a.codes.reshape([b, n]))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Features `[B, 4N, 263]` from tokens (each part may use its first few layers only).
+    pub fn decode(&self, tokens: &PartTokens) -> Tensor<3> {
+        let parts: Vec<Tensor<3>> = tokens
+            .iter()
+            .zip(&self.quantizers)
+            .map(|(layers, quantizer)| {
+                let [b, n] = layers[0].dims();
+                let flat: Vec<Tensor<1, Int>> =
+                    layers.iter().map(|t| t.clone().reshape([b * n])).collect();
+                Self::unrows(quantizer.dequantize(&flat), b, n)
+            })
+            .collect();
+        self.decoder.forward(Tensor::cat(parts, 1)).swap_dims(1, 2)
+    }
+
+    /// Encodes and decodes `x` with every layer (inference reconstruction).
+    pub fn reconstruct(&self, x: Tensor<3>) -> Tensor<3> {
+        self.decode(&self.tokenize(x))
+    }
+
+    /// Moving-average update of every codebook after a training step. Returns codes reset.
+    pub fn update_codebooks(
+        &mut self,
+        assignments: &[Vec<LayerAssignment>],
+        decay: f64,
+        rng: &mut Rng,
+    ) -> usize {
+        self.quantizers
+            .iter_mut()
+            .zip(assignments)
+            .map(|(q, a)| q.update(a, decay, rng))
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn small() -> VqConfig {
+        VqConfig::new()
+            .with_encoder_width(16)
+            .with_decoder_width(16)
+            .with_code_dim(8)
+            .with_codebook_size(32)
+            .with_layers(3)
+            .with_res_blocks(1)
+    }
+
+    fn motion(b: usize, t: usize, device: &Device) -> Tensor<3> {
+        Tensor::random([b, t, FEATURE_DIM], Distribution::Normal(0.0, 1.0), device)
+    }
+
+    #[test]
+    fn shapes_of_tokens_and_reconstruction() {
+        let device = Device::flex();
+        let vq = small().init(&device);
+        let x = motion(2, 24, &device);
+        let tokens = vq.tokenize(x.clone());
+        assert_eq!(tokens.len(), 4);
+        assert_eq!(tokens[0].len(), 3);
+        assert_eq!(tokens[2][1].dims(), [2, 6]);
+        assert_eq!(vq.decode(&tokens).dims(), [2, 24, FEATURE_DIM]);
+        let codes: Vec<i64> = tokens[1][0].clone().try_into_vec_as::<i64>().unwrap();
+        assert!(codes.iter().all(|c| (0..32).contains(c)));
+    }
+
+    #[test]
+    fn quantizing_a_code_vector_returns_that_code() {
+        let device = Device::flex();
+        let vq = small().init(&device);
+        let book = vq.quantizers[0].codebook(0);
+        let picks = Tensor::<1, Int>::from_data(TensorData::new(vec![3i32, 17, 3], [3]), &device);
+        let x = book.select(0, picks);
+        let (_, layers) = vq.quantizers[0].quantize(x, 1);
+        let codes: Vec<i64> = layers[0].codes.clone().try_into_vec_as::<i64>().unwrap();
+        assert_eq!(codes, vec![3, 17, 3]);
+    }
+
+    #[test]
+    fn training_step_reduces_the_loss_and_updates_codebooks() {
+        let device = Device::flex().autodiff();
+        let config = small();
+        let mut vq = config.init(&device);
+        let mut optim = burn::optim::AdamConfig::new().init();
+        let mut rng = Rng::new(1);
+        let x = motion(4, 16, &device);
+        let before = vq.quantizers[0]
+            .codebooks
+            .val()
+            .try_into_vec_as::<f32>()
+            .unwrap();
+        let mut losses: Vec<f32> = Vec::new();
+        for _ in 0..30 {
+            let out = vq.forward_train(
+                x.clone(),
+                &config.clone().with_quantize_dropout(0.0),
+                &mut rng,
+            );
+            let loss = (out.reconstruction - x.clone()).abs().mean() + out.commitment * 0.02;
+            losses.push(loss.clone().into_scalar::<f32>());
+            let grads = burn::optim::GradientsParams::from_grads(loss.backward(), &vq);
+            vq = optim.step(1e-2, vq, grads);
+            vq.update_codebooks(&out.assignments, config.ema_decay, &mut rng);
+        }
+        assert!(losses[29] < losses[0] * 0.9, "{losses:?}");
+        let after = vq.quantizers[0]
+            .codebooks
+            .val()
+            .try_into_vec_as::<f32>()
+            .unwrap();
+        assert_ne!(before, after, "codebooks move by moving averages");
+    }
+}

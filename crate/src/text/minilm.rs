@@ -1,0 +1,659 @@
+//! The all-MiniLM-L6-v2 sentence encoder (a 6-layer BERT, 384 wide) in burn: text → one
+//! L2-normalised 384-d vector per sentence, or per-token states for token-level conditioning.
+//!
+//! The page downloads the weights, so they are split in two files, neither needing the file
+//! system to load:
+//!
+//! - `minilm-words.i8`: the 30522 × 384 word-embedding table, 47 MB in f32, quantised to int8
+//!   with one f32 scale per row (see [`WordEmbeddings`] for the format). It is read on the CPU
+//!   in plain Rust because a sentence touches a dozen of its rows: giving the whole table to
+//!   the tensor backend would cost memory for nothing.
+//! - `minilm.bpk`: everything else ([`MiniLm`]), a burnpack with f16 weights that are widened
+//!   to f32 on load.
+//!
+//! [`convert_minilm`] writes both from the original `model.safetensors`; [`SentenceEncoder`]
+//! ties them to the tokenizer. Results match sentence-transformers (mean pooling over real
+//! tokens, then L2 normalisation) to a cosine above 0.999.
+
+use super::tokenizer::{Tokenizer, VocabError};
+use burn::module::Module;
+use burn::nn::attention::{MhaInput, MultiHeadAttention, MultiHeadAttentionConfig};
+use burn::nn::{Embedding, EmbeddingConfig, LayerNorm, LayerNormConfig, Linear, LinearConfig};
+use burn::prelude::*;
+use burn::store::{
+    BurnpackStore, HalfPrecisionAdapter, KeyRemapper, ModuleSnapshot, PyTorchToBurnAdapter,
+    SafetensorsStore,
+};
+use burn::tensor::activation::gelu;
+use burn::tensor::Bytes;
+use std::path::{Path, PathBuf};
+
+/// Width of the sentence embeddings and token states.
+pub const EMBEDDING_DIM: usize = 384;
+
+/// File names [`convert_minilm`] writes and [`SentenceEncoder::from_dir`] reads.
+pub const VOCAB_FILE: &str = "minilm-vocab.txt";
+/// The int8 word-embedding table (see [`WordEmbeddings`]).
+pub const WORDS_FILE: &str = "minilm-words.i8";
+/// The burnpack of the rest of the encoder.
+pub const MODEL_FILE: &str = "minilm.bpk";
+
+/// Shape of the encoder; the defaults are all-MiniLM-L6-v2's `config.json`.
+#[derive(Config, Debug)]
+pub struct MiniLmConfig {
+    /// Rows of the word-embedding table (kept outside the module, checked against it).
+    #[config(default = 30522)]
+    pub vocab_size: usize,
+    /// Width of every token state.
+    #[config(default = 384)]
+    pub hidden: usize,
+    /// Number of encoder layers.
+    #[config(default = 6)]
+    pub layers: usize,
+    /// Attention heads per layer.
+    #[config(default = 12)]
+    pub heads: usize,
+    /// Width of the feed-forward block.
+    #[config(default = 1536)]
+    pub intermediate: usize,
+    /// Longest sequence the position table covers.
+    #[config(default = 512)]
+    pub max_positions: usize,
+    /// Rows of the token-type table (only type 0 is used: one sentence per input).
+    #[config(default = 2)]
+    pub type_vocab: usize,
+    /// LayerNorm epsilon.
+    #[config(default = 1e-12)]
+    pub layer_norm_eps: f64,
+}
+
+impl MiniLmConfig {
+    /// A randomly initialised encoder; load weights into it with [`MiniLm::from_bytes`] or
+    /// burn-store.
+    pub fn init(&self, device: &Device) -> MiniLm {
+        let norm = LayerNormConfig::new(self.hidden).with_epsilon(self.layer_norm_eps);
+        MiniLm {
+            embeddings: Embeddings {
+                position: EmbeddingConfig::new(self.max_positions, self.hidden).init(device),
+                token_type: EmbeddingConfig::new(self.type_vocab, self.hidden).init(device),
+                layer_norm: norm.init(device),
+            },
+            layers: (0..self.layers)
+                .map(|_| EncoderLayer {
+                    // Inference only: dropout would be a no-op anyway, zero makes it explicit.
+                    attention: MultiHeadAttentionConfig::new(self.hidden, self.heads)
+                        .with_dropout(0.0)
+                        .init(device),
+                    attention_norm: norm.init(device),
+                    intermediate: LinearConfig::new(self.hidden, self.intermediate).init(device),
+                    output: LinearConfig::new(self.intermediate, self.hidden).init(device),
+                    output_norm: norm.init(device),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Position and token-type embeddings plus their LayerNorm (the word embeddings are added
+/// before, outside burn).
+#[derive(Module, Debug)]
+pub struct Embeddings {
+    position: Embedding,
+    token_type: Embedding,
+    layer_norm: LayerNorm,
+}
+
+/// One post-norm BERT layer: self-attention, then a GELU feed-forward block, each followed by
+/// a residual sum and a LayerNorm.
+#[derive(Module, Debug)]
+pub struct EncoderLayer {
+    attention: MultiHeadAttention,
+    attention_norm: LayerNorm,
+    intermediate: Linear,
+    output: Linear,
+    output_norm: LayerNorm,
+}
+
+impl EncoderLayer {
+    fn forward(&self, x: Tensor<3>, padding: Tensor<2, Bool>) -> Tensor<3> {
+        let attended = self
+            .attention
+            .forward(MhaInput::self_attn(x.clone()).mask_pad(padding))
+            .context;
+        let x = self.attention_norm.forward(x + attended);
+        // burn's `gelu` is the exact erf form, as BERT's "gelu".
+        let hidden = gelu(self.intermediate.forward(x.clone()));
+        self.output_norm.forward(x + self.output.forward(hidden))
+    }
+}
+
+/// The all-MiniLM-L6-v2 encoder minus its word-embedding table: word vectors in, contextual
+/// token states out.
+///
+/// ```text
+///  word vectors [B, L, 384]            (looked up on the CPU, see WordEmbeddings)
+///        |
+///        +-- + position[0..L] + token_type[0]
+///        v
+///    LayerNorm
+///        |
+///  6 x   +------------------------------------------------------+
+///        | x --> 12-head self-attention (padded keys masked)    |
+///        |   --> + x --> LayerNorm = y                          |
+///        | y --> Linear 384->1536 --> GELU --> Linear 1536->384 |
+///        |   --> + y --> LayerNorm                              |
+///        +------------------------------------------------------+
+///        v
+///  token states [B, L, 384]
+/// ```
+#[derive(Module, Debug)]
+pub struct MiniLm {
+    embeddings: Embeddings,
+    layers: Vec<EncoderLayer>,
+}
+
+impl MiniLm {
+    /// Token states `[B, L, 384]` of word vectors `[B, L, 384]`. `padding` is `[B, L]`, true
+    /// at padded positions: they are never attended to, and their own output rows are
+    /// meaningless (mask them out downstream).
+    pub fn forward(&self, words: Tensor<3>, padding: Tensor<2, Bool>) -> Tensor<3> {
+        let [_, len, _] = words.dims();
+        let device = words.device();
+        let positions = Tensor::<1, Int>::arange(0..len as i64, &device).reshape([1, len]);
+        let token_type = Tensor::<2, Int>::zeros([1, 1], &device);
+        let x = words
+            + self.embeddings.position.forward(positions)
+            + self.embeddings.token_type.forward(token_type);
+        let mut x = self.embeddings.layer_norm.forward(x);
+        for layer in &self.layers {
+            x = layer.forward(x, padding.clone());
+        }
+        x
+    }
+
+    /// Loads an encoder from burnpack bytes written by [`convert_minilm`] (f16 weights,
+    /// widened to f32). Fails, without panicking, on bytes that are not such a file.
+    pub fn from_bytes(bytes: &[u8], device: &Device) -> Result<MiniLm, MiniLmError> {
+        let mut model = MiniLmConfig::new().init(device);
+        let mut store = BurnpackStore::from_bytes(Some(Bytes::from_bytes_vec(bytes.to_vec())))
+            .with_from_adapter(HalfPrecisionAdapter::new());
+        model
+            .load_from(&mut store)
+            .map_err(|e| MiniLmError::Model(e.to_string()))?;
+        Ok(model)
+    }
+
+    /// Burnpack bytes of this encoder with Linear, Embedding and LayerNorm weights in f16 (the
+    /// download is half the size; the encoder's outputs move by less than 1e-3 in cosine).
+    pub fn to_bytes(&self) -> Result<Vec<u8>, MiniLmError> {
+        let mut store = BurnpackStore::from_bytes(None)
+            .with_to_adapter(HalfPrecisionAdapter::new())
+            .metadata("model", "all-MiniLM-L6-v2 without word embeddings");
+        self.save_into(&mut store)
+            .map_err(|e| MiniLmError::Model(e.to_string()))?;
+        let bytes = store
+            .get_bytes()
+            .map_err(|e| MiniLmError::Model(e.to_string()))?;
+        Ok(bytes.to_vec())
+    }
+}
+
+/// Why an encoder could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum MiniLmError {
+    /// The vocabulary text is unusable.
+    #[error("vocabulary: {0}")]
+    Vocab(#[from] VocabError),
+    /// The word-embedding bytes are not a valid table.
+    #[error("word embeddings: {0}")]
+    Words(#[from] WordsFormatError),
+    /// The burnpack bytes are not a valid encoder.
+    #[error("encoder weights: {0}")]
+    Model(String),
+    /// The three parts do not belong together.
+    #[error("mismatched parts: {0}")]
+    Mismatch(String),
+    /// A file of [`SentenceEncoder::from_dir`] could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+/// Why bytes are not a word-embedding table.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum WordsFormatError {
+    /// The first four bytes are not [`WordEmbeddings::MAGIC`].
+    #[error("not a word-embedding file (bad magic bytes)")]
+    BadMagic,
+    /// A format version this code does not know.
+    #[error("unsupported format version {0}")]
+    Version(u32),
+    /// The byte count disagrees with the header's rows and columns.
+    #[error("expected {expected} bytes, found {found}")]
+    Length {
+        /// Byte count the header implies.
+        expected: u64,
+        /// Byte count given.
+        found: u64,
+    },
+    /// A row scale is negative, infinite or NaN.
+    #[error("row {0} has an invalid scale")]
+    BadScale(usize),
+}
+
+/// A word-embedding table quantised to int8 with one f32 scale per row (symmetric:
+/// `scale = max|row| / 127`, `value ≈ q * scale`), looked up on the CPU.
+///
+/// File format (`minilm-words.i8`), little endian, no padding:
+///
+/// | offset | size | content |
+/// |---|---|---|
+/// | 0 | 4 | magic `b"CMWE"` ([`Self::MAGIC`]) |
+/// | 4 | 4 | `u32` version, 1 |
+/// | 8 | 4 | `u32` rows |
+/// | 12 | 4 | `u32` cols |
+/// | 16 | 4 × rows | `f32` scale of each row |
+/// | 16 + 4 × rows | rows × cols | `i8` values, row-major |
+#[derive(Clone, Debug, PartialEq)]
+pub struct WordEmbeddings {
+    rows: usize,
+    cols: usize,
+    scales: Vec<f32>,
+    values: Vec<i8>,
+}
+
+impl WordEmbeddings {
+    /// First bytes of the file ("CoMA word embeddings").
+    pub const MAGIC: [u8; 4] = *b"CMWE";
+    /// Format version written by [`Self::to_bytes`].
+    pub const VERSION: u32 = 1;
+    const HEADER: usize = 16;
+
+    /// Quantises a row-major `rows × cols` f32 table.
+    ///
+    /// # Panics
+    /// If `table.len() != rows * cols`.
+    pub fn quantize(table: &[f32], rows: usize, cols: usize) -> WordEmbeddings {
+        assert_eq!(table.len(), rows * cols, "table is not rows × cols");
+        let mut scales = Vec::with_capacity(rows);
+        let mut values = Vec::with_capacity(rows * cols);
+        for row in table.chunks_exact(cols.max(1)).take(rows) {
+            let max = row.iter().fold(0f32, |m, v| m.max(v.abs()));
+            let scale = max / 127.0;
+            scales.push(scale);
+            // An all-zero row keeps scale 0; dividing by it would give NaN.
+            let inv = if scale > 0.0 { 1.0 / scale } else { 0.0 };
+            values.extend(
+                row.iter()
+                    .map(|v| (v * inv).round().clamp(-127.0, 127.0) as i8),
+            );
+        }
+        WordEmbeddings {
+            rows,
+            cols,
+            scales,
+            values,
+        }
+    }
+
+    /// Parses the file format above, checking the header against the byte count.
+    pub fn from_bytes(bytes: &[u8]) -> Result<WordEmbeddings, WordsFormatError> {
+        let length_error = |expected: u64| WordsFormatError::Length {
+            expected,
+            found: bytes.len() as u64,
+        };
+        if bytes.len() < Self::HEADER {
+            return Err(length_error(Self::HEADER as u64));
+        }
+        if bytes[0..4] != Self::MAGIC {
+            return Err(WordsFormatError::BadMagic);
+        }
+        let word = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
+        let version = word(4);
+        if version != Self::VERSION {
+            return Err(WordsFormatError::Version(version));
+        }
+        let (rows, cols) = (word(8) as u64, word(12) as u64);
+        // u64 so that a corrupt header cannot overflow the size computation.
+        let expected = Self::HEADER as u64 + 4 * rows + rows * cols;
+        if bytes.len() as u64 != expected {
+            return Err(length_error(expected));
+        }
+        let (rows, cols) = (rows as usize, cols as usize);
+        let scales_end = Self::HEADER + 4 * rows;
+        let scales: Vec<f32> = bytes[Self::HEADER..scales_end]
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        if let Some(bad) = scales.iter().position(|s| !s.is_finite() || *s < 0.0) {
+            return Err(WordsFormatError::BadScale(bad));
+        }
+        let values = bytes[scales_end..].iter().map(|&b| b as i8).collect();
+        Ok(WordEmbeddings {
+            rows,
+            cols,
+            scales,
+            values,
+        })
+    }
+
+    /// The file format above.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(Self::HEADER + 4 * self.rows + self.values.len());
+        out.extend_from_slice(&Self::MAGIC);
+        out.extend_from_slice(&Self::VERSION.to_le_bytes());
+        out.extend_from_slice(&(self.rows as u32).to_le_bytes());
+        out.extend_from_slice(&(self.cols as u32).to_le_bytes());
+        for s in &self.scales {
+            out.extend_from_slice(&s.to_le_bytes());
+        }
+        out.extend(self.values.iter().map(|&v| v as u8));
+        out
+    }
+
+    /// Number of rows (vocabulary size).
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Width of each row.
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+
+    /// The dequantised rows of `ids`, concatenated (`ids.len() × cols` values).
+    ///
+    /// # Panics
+    /// If an id is not below [`Self::rows`].
+    pub fn lookup(&self, ids: &[u32]) -> Vec<f32> {
+        let mut out = Vec::with_capacity(ids.len() * self.cols);
+        for &id in ids {
+            let id = id as usize;
+            assert!(id < self.rows, "token id {id} outside the word table");
+            let scale = self.scales[id];
+            let row = &self.values[id * self.cols..(id + 1) * self.cols];
+            out.extend(row.iter().map(|&q| q as f32 * scale));
+        }
+        out
+    }
+}
+
+/// all-MiniLM-L6-v2 end to end: tokenizer, int8 word table and burn encoder on one device.
+#[derive(Debug)]
+pub struct SentenceEncoder {
+    tokenizer: Tokenizer,
+    words: WordEmbeddings,
+    model: MiniLm,
+    device: Device,
+}
+
+impl SentenceEncoder {
+    /// Builds the encoder from the contents of its three files (no file system access, so it
+    /// works in the browser): `vocab` is `minilm-vocab.txt`, `words` `minilm-words.i8`,
+    /// `model` `minilm.bpk`.
+    pub fn from_bytes(
+        vocab: &str,
+        words: &[u8],
+        model: &[u8],
+        device: &Device,
+    ) -> Result<SentenceEncoder, MiniLmError> {
+        let tokenizer = Tokenizer::from_vocab(vocab)?;
+        let words = WordEmbeddings::from_bytes(words)?;
+        if words.rows() != tokenizer.vocab_size() || words.cols() != EMBEDDING_DIM {
+            return Err(MiniLmError::Mismatch(format!(
+                "vocabulary of {} tokens, word table of {} × {} (expected {} × {EMBEDDING_DIM})",
+                tokenizer.vocab_size(),
+                words.rows(),
+                words.cols(),
+                tokenizer.vocab_size()
+            )));
+        }
+        let model = MiniLm::from_bytes(model, device)?;
+        Ok(SentenceEncoder {
+            tokenizer,
+            words,
+            model,
+            device: device.clone(),
+        })
+    }
+
+    /// Reads [`VOCAB_FILE`], [`WORDS_FILE`] and [`MODEL_FILE`] from `dir` (e.g.
+    /// `static/models`) and calls [`Self::from_bytes`].
+    pub fn from_dir(dir: &Path, device: &Device) -> Result<SentenceEncoder, MiniLmError> {
+        let read = |name: &str| {
+            let path = dir.join(name);
+            std::fs::read(&path).map_err(|source| MiniLmError::Io { path, source })
+        };
+        let vocab = read(VOCAB_FILE)?;
+        let vocab = String::from_utf8(vocab).map_err(|e| MiniLmError::Io {
+            path: dir.join(VOCAB_FILE),
+            source: std::io::Error::new(std::io::ErrorKind::InvalidData, e),
+        })?;
+        Self::from_bytes(&vocab, &read(WORDS_FILE)?, &read(MODEL_FILE)?, device)
+    }
+
+    /// The tokenizer, e.g. to show how a prompt was split.
+    pub fn tokenizer(&self) -> &Tokenizer {
+        &self.tokenizer
+    }
+
+    /// The device the encoder runs on.
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// Token states `[B, L, 384]` of `texts`, padded to the longest (`L` counts `[CLS]` and
+    /// `[SEP]`), and the padding mask `[B, L]`, true at padded positions, whose states are
+    /// meaningless.
+    ///
+    /// # Panics
+    /// If `texts` is empty.
+    pub fn encode_tokens(&self, texts: &[&str]) -> (Tensor<3>, Tensor<2, Bool>) {
+        assert!(!texts.is_empty(), "encode_tokens needs at least one text");
+        let ids: Vec<Vec<u32>> = texts.iter().map(|t| self.tokenizer.encode(t)).collect();
+        let len = ids.iter().map(Vec::len).max().unwrap_or(0);
+        let mut flat = Vec::with_capacity(texts.len() * len);
+        let mut padding = Vec::with_capacity(texts.len() * len);
+        for row in &ids {
+            flat.extend_from_slice(row);
+            flat.resize(flat.len() + len - row.len(), self.tokenizer.pad);
+            padding.extend((0..len).map(|i| i >= row.len()));
+        }
+        let words = Tensor::<3>::from_data(
+            TensorData::new(self.words.lookup(&flat), [texts.len(), len, EMBEDDING_DIM]),
+            &self.device,
+        );
+        let padding = Tensor::<2, Bool>::from_data(
+            TensorData::new(padding, [texts.len(), len]),
+            &self.device,
+        );
+        (self.model.forward(words, padding.clone()), padding)
+    }
+
+    /// One L2-normalised sentence embedding per text: the mean of its token states over real
+    /// tokens (`[CLS]` and `[SEP]` included, padding excluded), as sentence-transformers.
+    pub fn encode(&self, texts: &[&str]) -> Vec<[f32; EMBEDDING_DIM]> {
+        if texts.is_empty() {
+            return Vec::new();
+        }
+        let (states, padding) = self.encode_tokens(texts);
+        let keep = padding.bool_not().float().unsqueeze_dim::<3>(2);
+        let counts = keep.clone().sum_dim(1);
+        let mean = (states * keep).sum_dim(1) / counts;
+        let norm = mean
+            .clone()
+            .powi_scalar(2)
+            .sum_dim(2)
+            .sqrt()
+            .clamp_min(1e-12);
+        let pooled: Vec<f32> = (mean / norm)
+            .try_into_vec_as::<f32>()
+            .expect("a float tensor reads back as f32");
+        pooled
+            .chunks_exact(EMBEDDING_DIM)
+            .map(|c| c.try_into().unwrap())
+            .collect()
+    }
+}
+
+/// What [`convert_minilm`] wrote.
+#[derive(Clone, Debug)]
+pub struct ConvertReport {
+    /// The int8 word-embedding table.
+    pub words_path: PathBuf,
+    /// Its size in bytes.
+    pub words_bytes: u64,
+    /// The burnpack of the rest.
+    pub model_path: PathBuf,
+    /// Its size in bytes.
+    pub model_bytes: u64,
+    /// Largest absolute error of a dequantised word-embedding value.
+    pub words_max_error: f32,
+}
+
+/// The original checkpoint as one module, so that a single safetensors load fills both the
+/// word table and the encoder.
+#[derive(Module, Debug)]
+struct Checkpoint {
+    words: Embedding,
+    encoder: MiniLm,
+}
+
+/// HF BERT key → path in [`Checkpoint`]. Patterns run in order on the already-renamed key;
+/// each one's prefix (`embeddings.`, `encoder.layer.`) no longer matches once renamed.
+const KEY_MAP: [(&str, &str); 9] = [
+    (r"^embeddings\.word_embeddings\.", "words."),
+    (
+        r"^embeddings\.LayerNorm\.",
+        "encoder.embeddings.layer_norm.",
+    ),
+    (
+        r"^embeddings\.(position|token_type)_embeddings\.",
+        "encoder.embeddings.$1.",
+    ),
+    (
+        r"^encoder\.layer\.(\d+)\.attention\.self\.(query|key|value)\.",
+        "encoder.layers.$1.attention.$2.",
+    ),
+    (
+        r"^encoder\.layer\.(\d+)\.attention\.output\.dense\.",
+        "encoder.layers.$1.attention.output.",
+    ),
+    (
+        r"^encoder\.layer\.(\d+)\.attention\.output\.LayerNorm\.",
+        "encoder.layers.$1.attention_norm.",
+    ),
+    (
+        r"^encoder\.layer\.(\d+)\.intermediate\.dense\.",
+        "encoder.layers.$1.intermediate.",
+    ),
+    (
+        r"^encoder\.layer\.(\d+)\.output\.dense\.",
+        "encoder.layers.$1.output.",
+    ),
+    (
+        r"^encoder\.layer\.(\d+)\.output\.LayerNorm\.",
+        "encoder.layers.$1.output_norm.",
+    ),
+];
+
+/// Converts the original all-MiniLM-L6-v2 checkpoint (`model_dir` holds HF's
+/// `model.safetensors` and `config.json`) into [`WORDS_FILE`] and [`MODEL_FILE`] in `out_dir`.
+/// The vocabulary is not touched: `minilm-vocab.txt` is HF's `vocab.txt` as is.
+pub fn convert_minilm(model_dir: &Path, out_dir: &Path) -> anyhow::Result<ConvertReport> {
+    use anyhow::Context;
+    let config = MiniLmConfig::new();
+    check_hf_config(&model_dir.join("config.json"), &config)?;
+
+    // The conversion is a one-off on the CPU, whatever the page later runs on.
+    let device = Device::flex();
+    let mut checkpoint = Checkpoint {
+        words: EmbeddingConfig::new(config.vocab_size, config.hidden).init(&device),
+        encoder: config.init(&device),
+    };
+    let remapper = KEY_MAP
+        .iter()
+        .try_fold(KeyRemapper::new(), |r, (from, to)| r.add_pattern(from, *to))
+        .map_err(|e| anyhow::anyhow!("bad key pattern: {e}"))?;
+    let weights = model_dir.join("model.safetensors");
+    // PyTorchToBurnAdapter transposes Linear weights ([out, in] → [in, out]) and renames
+    // LayerNorm weight/bias to gamma/beta; unused keys (position_ids, pooler) are ignored,
+    // missing ones are an error.
+    let mut store = SafetensorsStore::from_file(&weights)
+        .remap(remapper)
+        .with_from_adapter(PyTorchToBurnAdapter);
+    let result = checkpoint
+        .load_from(&mut store)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", weights.display()))?;
+    anyhow::ensure!(
+        result.errors.is_empty() && result.missing.is_empty(),
+        "{}: {result}",
+        weights.display()
+    );
+
+    let table: Vec<f32> = checkpoint
+        .words
+        .weight
+        .val()
+        .try_into_vec_as::<f32>()
+        .map_err(|e| anyhow::anyhow!("reading the word table: {e:?}"))?;
+    let words = WordEmbeddings::quantize(&table, config.vocab_size, config.hidden);
+    let ids: Vec<u32> = (0..config.vocab_size as u32).collect();
+    let words_max_error = words
+        .lookup(&ids)
+        .iter()
+        .zip(&table)
+        .fold(0f32, |m, (a, b)| m.max((a - b).abs()));
+
+    std::fs::create_dir_all(out_dir).with_context(|| out_dir.display().to_string())?;
+    let words_path = out_dir.join(WORDS_FILE);
+    let words_bytes = words.to_bytes();
+    std::fs::write(&words_path, &words_bytes).with_context(|| words_path.display().to_string())?;
+    let model_path = out_dir.join(MODEL_FILE);
+    let model_bytes = checkpoint.encoder.to_bytes()?;
+    std::fs::write(&model_path, &model_bytes).with_context(|| model_path.display().to_string())?;
+    Ok(ConvertReport {
+        words_path,
+        words_bytes: words_bytes.len() as u64,
+        model_path,
+        model_bytes: model_bytes.len() as u64,
+        words_max_error,
+    })
+}
+
+/// Refuses a checkpoint whose HF `config.json` describes another shape than `config`.
+fn check_hf_config(path: &Path, config: &MiniLmConfig) -> anyhow::Result<()> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let hf: serde_json::Value = serde_json::from_str(&text)?;
+    anyhow::ensure!(
+        hf["hidden_act"] == "gelu",
+        "{}: hidden_act is {}, expected \"gelu\" (erf)",
+        path.display(),
+        hf["hidden_act"]
+    );
+    let expected = [
+        ("vocab_size", config.vocab_size as f64),
+        ("hidden_size", config.hidden as f64),
+        ("num_hidden_layers", config.layers as f64),
+        ("num_attention_heads", config.heads as f64),
+        ("intermediate_size", config.intermediate as f64),
+        ("max_position_embeddings", config.max_positions as f64),
+        ("type_vocab_size", config.type_vocab as f64),
+        ("layer_norm_eps", config.layer_norm_eps),
+    ];
+    for (key, value) in expected {
+        let found = hf[key].as_f64();
+        anyhow::ensure!(
+            found == Some(value),
+            "{}: {key} is {:?}, expected {value}",
+            path.display(),
+            found
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,277 @@
+//! What every training run shares: its folder, resumable checkpoints written every few
+//! minutes, the loss log (CSV) with its PNG plot, and the progress line.
+//!
+//! A run folder holds `config.json`, `log.csv`, `losses.png` and `checkpoint/` with
+//! `model.bpk`, `optim.bpk` and `state.json`. A checkpoint is written to `checkpoint.tmp/`
+//! and renamed into place, so a run stopped at any moment leaves the previous one intact.
+
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Where a run stands; saved with every checkpoint.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct RunState {
+    /// Optimizer steps done.
+    pub step: usize,
+    /// Seconds of training so far, over all sessions.
+    pub seconds: f64,
+    /// Samples seen so far.
+    pub samples: u64,
+}
+
+/// A training run's folder and bookkeeping.
+pub struct Run {
+    pub dir: PathBuf,
+    pub state: RunState,
+    started: Instant,
+    seconds_at_start: f64,
+    last_checkpoint: Instant,
+    log: std::fs::File,
+    columns: Vec<String>,
+}
+
+impl Run {
+    /// Opens (or starts) the run in `dir`. Returns the run and whether a checkpoint exists to
+    /// resume from.
+    pub fn open(dir: &Path, columns: &[&str]) -> Result<(Run, bool)> {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let state_path = dir.join("checkpoint").join("state.json");
+        let (state, resumed) = match std::fs::read_to_string(&state_path) {
+            Ok(text) => (
+                serde_json::from_str(&text)
+                    .with_context(|| format!("{} is damaged", state_path.display()))?,
+                true,
+            ),
+            Err(_) => (RunState::default(), false),
+        };
+        let log_path = dir.join("log.csv");
+        let new_log = !log_path.exists() || !resumed;
+        if !new_log {
+            // Steps logged after the checkpoint will be trained again: drop them.
+            let text = std::fs::read_to_string(&log_path)?;
+            let kept: Vec<&str> = text
+                .lines()
+                .enumerate()
+                .filter(|(i, l)| {
+                    *i == 0
+                        || l.split(',')
+                            .next()
+                            .and_then(|s| s.parse::<usize>().ok())
+                            .is_some_and(|s| s <= state.step)
+                })
+                .map(|(_, l)| l)
+                .collect();
+            std::fs::write(&log_path, kept.join("\n") + "\n")?;
+        }
+        let mut log = if new_log {
+            std::fs::File::create(&log_path)?
+        } else {
+            std::fs::OpenOptions::new().append(true).open(&log_path)?
+        };
+        if new_log {
+            writeln!(log, "step,seconds,{}", columns.join(","))?;
+        }
+        let seconds_at_start = state.seconds;
+        Ok((
+            Run {
+                dir: dir.to_path_buf(),
+                state,
+                started: Instant::now(),
+                seconds_at_start,
+                last_checkpoint: Instant::now(),
+                log,
+                columns: columns.iter().map(|c| c.to_string()).collect(),
+            },
+            resumed,
+        ))
+    }
+
+    /// Path of a file of the latest checkpoint.
+    pub fn checkpoint_file(&self, name: &str) -> PathBuf {
+        self.dir.join("checkpoint").join(name)
+    }
+
+    /// Records one step: `samples` processed and the logged values (in column order).
+    pub fn record(&mut self, samples: usize, values: &[f64]) -> Result<()> {
+        self.state.step += 1;
+        self.state.samples += samples as u64;
+        self.state.seconds = self.seconds_at_start + self.started.elapsed().as_secs_f64();
+        let cells: Vec<String> = values.iter().map(|v| format!("{v:.6}")).collect();
+        writeln!(
+            self.log,
+            "{},{:.1},{}",
+            self.state.step,
+            self.state.seconds,
+            cells.join(",")
+        )?;
+        Ok(())
+    }
+
+    /// Samples per second in this session.
+    pub fn samples_per_second(&self, samples_at_start: u64) -> f64 {
+        (self.state.samples - samples_at_start) as f64
+            / self.started.elapsed().as_secs_f64().max(1e-9)
+    }
+
+    /// A progress line: step, epoch, the latest values, throughput and time left.
+    pub fn progress_line(
+        &self,
+        total_steps: usize,
+        epoch: f64,
+        values: &[f64],
+        samples_per_second: f64,
+        seconds_per_step: f64,
+    ) -> String {
+        let named: Vec<String> = self
+            .columns
+            .iter()
+            .zip(values)
+            .map(|(c, v)| format!("{c} {v:.4}"))
+            .collect();
+        let eta = (total_steps.saturating_sub(self.state.step)) as f64 * seconds_per_step;
+        format!(
+            "epoch {epoch:.2} step {}/{total_steps} {} | {samples_per_second:.1} samples/s | ETA {}",
+            self.state.step,
+            named.join(" "),
+            format_duration(eta)
+        )
+    }
+
+    /// True when `minutes` have passed since the last checkpoint.
+    pub fn checkpoint_due(&self, minutes: f64) -> bool {
+        self.last_checkpoint.elapsed().as_secs_f64() >= minutes * 60.0
+    }
+
+    /// Writes a checkpoint: `write` puts its files into the given folder, then the state is
+    /// added and the folder atomically replaces the previous checkpoint.
+    pub fn checkpoint(&mut self, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+        let tmp = self.dir.join("checkpoint.tmp");
+        let _ = std::fs::remove_dir_all(&tmp);
+        std::fs::create_dir_all(&tmp)?;
+        write(&tmp)?;
+        std::fs::write(
+            tmp.join("state.json"),
+            serde_json::to_string_pretty(&self.state)?,
+        )?;
+        let dest = self.dir.join("checkpoint");
+        let old = self.dir.join("checkpoint.old");
+        let _ = std::fs::remove_dir_all(&old);
+        if dest.exists() {
+            std::fs::rename(&dest, &old)?;
+        }
+        std::fs::rename(&tmp, &dest)?;
+        let _ = std::fs::remove_dir_all(&old);
+        self.log.flush()?;
+        self.last_checkpoint = Instant::now();
+        Ok(())
+    }
+
+    /// Redraws `losses.png` from `log.csv`, one curve per column, averaged over windows of
+    /// `smooth` steps so the trend is readable.
+    pub fn plot(&self, title: &str, smooth: usize) -> Result<()> {
+        let series = read_log(&self.dir.join("log.csv"), smooth)?;
+        let options = crate::render::plot::PlotOptions {
+            title: title.to_string(),
+            x_label: "step".into(),
+            y_label: "loss".into(),
+            log_y: true,
+            ..Default::default()
+        };
+        crate::render::plot::write_line_plot(&self.dir.join("losses.png"), &series, &options)?;
+        Ok(())
+    }
+}
+
+/// The curves of a `log.csv`, averaged over consecutive windows of `smooth` rows.
+pub fn read_log(path: &Path, smooth: usize) -> Result<Vec<crate::render::plot::Series>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let mut columns: BTreeMap<usize, Vec<(f64, f64)>> = BTreeMap::new();
+    for line in lines {
+        let cells: Vec<f64> = line
+            .split(',')
+            .map(|c| c.parse().unwrap_or(f64::NAN))
+            .collect();
+        for (i, v) in cells.iter().enumerate().skip(2) {
+            columns.entry(i).or_default().push((cells[0], *v));
+        }
+    }
+    let smooth = smooth.max(1);
+    Ok(columns
+        .into_iter()
+        .map(|(i, points)| crate::render::plot::Series {
+            name: header.get(i).unwrap_or(&"?").to_string(),
+            points: points
+                .chunks(smooth)
+                .map(|c| {
+                    let finite: Vec<&(f64, f64)> = c.iter().filter(|p| p.1.is_finite()).collect();
+                    let n = finite.len().max(1) as f64;
+                    (
+                        c[c.len() - 1].0,
+                        finite.iter().map(|p| p.1).sum::<f64>() / n,
+                    )
+                })
+                .collect(),
+        })
+        .collect())
+}
+
+/// `1h 02m` / `3m 20s` / `12s`.
+pub fn format_duration(seconds: f64) -> String {
+    let s = seconds.max(0.0) as u64;
+    if s >= 3600 {
+        format!("{}h {:02}m", s / 3600, (s % 3600) / 60)
+    } else if s >= 60 {
+        format!("{}m {:02}s", s / 60, s % 60)
+    } else {
+        format!("{s}s")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checkpoints_resume_state_and_log() {
+        let tmp = tempfile::tempdir().unwrap();
+        let (mut run, resumed) = Run::open(tmp.path(), &["loss"]).unwrap();
+        assert!(!resumed);
+        run.record(8, &[1.5]).unwrap();
+        run.record(8, &[1.0]).unwrap();
+        run.checkpoint(|dir| Ok(std::fs::write(dir.join("model.bpk"), b"weights")?))
+            .unwrap();
+        run.record(8, &[0.5]).unwrap();
+        drop(run);
+        let (run, resumed) = Run::open(tmp.path(), &["loss"]).unwrap();
+        assert!(resumed);
+        assert_eq!(
+            run.state.step, 2,
+            "resumes from the checkpoint, not from the last step"
+        );
+        assert_eq!(
+            std::fs::read(run.checkpoint_file("model.bpk")).unwrap(),
+            b"weights"
+        );
+        let series = read_log(&tmp.path().join("log.csv"), 1).unwrap();
+        assert_eq!(series[0].name, "loss");
+        assert_eq!(
+            series[0].points.len(),
+            2,
+            "the step after the checkpoint is dropped"
+        );
+    }
+
+    #[test]
+    fn durations_read_well() {
+        assert_eq!(format_duration(12.4), "12s");
+        assert_eq!(format_duration(200.0), "3m 20s");
+        assert_eq!(format_duration(3720.0), "1h 02m");
+    }
+}

@@ -1,0 +1,175 @@
+//! The training data of the transformers: every training motion as VQ tokens, with the
+//! sentence embeddings of its captions and per-part sentences, and masked batches of it.
+
+use super::motions::MotionSet;
+use crate::model::transformer::{TransformerConfig, PARTS, TEXT_DIM};
+use crate::model::vq::{MotionVq, DOWNSAMPLE};
+use crate::rng::Rng;
+use crate::skeleton::BodyPart;
+use anyhow::Result;
+use burn::prelude::*;
+use burn::tensor::{Bool, Int, TensorData};
+use std::collections::HashMap;
+
+/// One motion as tokens and text.
+#[derive(Clone, Debug)]
+pub struct TokenItem {
+    /// `[part][layer][step]` codes.
+    pub tokens: Vec<Vec<Vec<u32>>>,
+    /// Indices of the item's global captions in [`TokenSet::texts`].
+    pub captions: Vec<usize>,
+    /// Index of each part's sentence in [`TokenSet::texts`], where the dataset has one.
+    pub parts: [Option<usize>; PARTS],
+}
+
+/// Token items plus the embeddings of every text they use.
+#[derive(Clone, Debug)]
+pub struct TokenSet {
+    pub items: Vec<TokenItem>,
+    pub texts: Vec<String>,
+    pub embeddings: Vec<[f32; TEXT_DIM]>,
+}
+
+/// A batch for the transformers: inputs, targets and conditions.
+#[derive(Debug)]
+pub struct TokenBatch {
+    /// `[B, 4, L, N]` all layers' tokens, padded with the pad id, row-major.
+    pub tokens: Vec<i32>,
+    /// `(B, L, N)` of `tokens`.
+    pub dims: (usize, usize, usize),
+    /// `[B, 4, 384]` per-part text.
+    pub text: Tensor<3>,
+    /// `[B, 4]` 1 keeps the text, 0 drops it (guidance training).
+    pub keep_text: Tensor<2>,
+    /// `[B, N]` true after the end of a motion.
+    pub pad: Tensor<2, Bool>,
+    /// Real steps of each motion.
+    pub lengths: Vec<usize>,
+}
+
+impl TokenSet {
+    /// Tokenizes every motion of `set` with `vq` (each cut to a multiple of 4 frames) and
+    /// embeds every distinct text with `embed` (a batch of texts → one vector each).
+    pub fn build(
+        set: &MotionSet,
+        vq: &MotionVq,
+        device: &Device,
+        embed: &dyn Fn(&[&str]) -> Result<Vec<[f32; TEXT_DIM]>>,
+        progress: &dyn Fn(&str),
+    ) -> Result<TokenSet> {
+        let mut texts: Vec<String> = Vec::new();
+        let mut index: HashMap<String, usize> = HashMap::new();
+        let mut intern = |t: &str| -> usize {
+            *index.entry(t.to_string()).or_insert_with(|| {
+                texts.push(t.to_string());
+                texts.len() - 1
+            })
+        };
+        let mut items = Vec::with_capacity(set.items.len());
+        for (i, item) in set.items.iter().enumerate() {
+            let t = item.features.len() / DOWNSAMPLE * DOWNSAMPLE;
+            let flat: Vec<f32> = item.features[..t].iter().flatten().copied().collect();
+            let x = Tensor::<3>::from_data(
+                TensorData::new(flat, [1, t, crate::features::FEATURE_DIM]),
+                device,
+            );
+            let tokens = vq
+                .tokenize(x)
+                .into_iter()
+                .map(|layers| {
+                    layers
+                        .into_iter()
+                        .map(|l| {
+                            l.try_into_vec_as::<i64>()
+                                .expect("int tokens")
+                                .into_iter()
+                                .map(|v| v as u32)
+                                .collect()
+                        })
+                        .collect()
+                })
+                .collect();
+            let captions = item.captions.iter().map(|c| intern(c)).collect();
+            let parts =
+                std::array::from_fn(|p| item.parts.get(&BodyPart::ALL[p]).map(|s| intern(s)));
+            items.push(TokenItem {
+                tokens,
+                captions,
+                parts,
+            });
+            if (i + 1) % 500 == 0 {
+                progress(&format!("tokenized {}/{} motions", i + 1, set.items.len()));
+            }
+        }
+        let mut embeddings = Vec::with_capacity(texts.len());
+        for chunk in texts.chunks(64) {
+            let refs: Vec<&str> = chunk.iter().map(String::as_str).collect();
+            embeddings.extend(embed(&refs)?);
+        }
+        progress(&format!("embedded {} distinct texts", texts.len()));
+        Ok(TokenSet {
+            items,
+            texts,
+            embeddings,
+        })
+    }
+
+    /// A random batch of `batch` motions. Each part's condition is the motion's own sentence
+    /// for that part with probability `part_text`, else one of its global captions (the same
+    /// for all parts that use it); the whole text is dropped with probability `drop_text`.
+    pub fn batch(
+        &self,
+        config: &TransformerConfig,
+        rng: &mut Rng,
+        batch: usize,
+        part_text: f32,
+        drop_text: f32,
+        device: &Device,
+    ) -> TokenBatch {
+        let picks: Vec<&TokenItem> = (0..batch)
+            .map(|_| &self.items[rng.below(self.items.len())])
+            .collect();
+        let lengths: Vec<usize> = picks.iter().map(|i| i.tokens[0][0].len()).collect();
+        let n = lengths.iter().copied().max().unwrap_or(1);
+        let layers = picks[0].tokens[0].len();
+        let pad_id = config.pad_id() as i32;
+        let mut tokens = Vec::with_capacity(batch * PARTS * layers * n);
+        let mut text = Vec::with_capacity(batch * PARTS * TEXT_DIM);
+        let mut keep = Vec::with_capacity(batch * PARTS);
+        let mut pad = Vec::with_capacity(batch * n);
+        for item in &picks {
+            for part in &item.tokens {
+                for layer in part {
+                    tokens.extend(layer.iter().map(|t| *t as i32));
+                    tokens.extend(std::iter::repeat_n(pad_id, n - layer.len()));
+                }
+            }
+            let global = item.captions.get(rng.below(item.captions.len())).copied();
+            let dropped = rng.uniform() < drop_text;
+            for p in 0..PARTS {
+                let own = item.parts[p].filter(|_| rng.uniform() < part_text);
+                let chosen = own.or(global);
+                match chosen {
+                    Some(t) => text.extend_from_slice(&self.embeddings[t]),
+                    None => text.extend(std::iter::repeat_n(0.0, TEXT_DIM)),
+                }
+                keep.push(if dropped || chosen.is_none() {
+                    0.0
+                } else {
+                    1.0
+                });
+            }
+            let len = item.tokens[0][0].len();
+            pad.extend((0..n).map(|s| (s >= len) as i32));
+        }
+        TokenBatch {
+            tokens,
+            dims: (batch, layers, n),
+            text: Tensor::from_data(TensorData::new(text, [batch, PARTS, TEXT_DIM]), device),
+            keep_text: Tensor::from_data(TensorData::new(keep, [batch, PARTS]), device),
+            pad: Tensor::<2, Int>::from_data(TensorData::new(pad, [batch, n]), device)
+                .equal_elem(1),
+            lengths,
+        }
+    }
+}

@@ -1,0 +1,318 @@
+//! Training the base and residual transformers (`coma train base|res`): masked-token
+//! prediction with a cosine masking schedule (base) or next-layer prediction (residual), label
+//! smoothing, text dropout for classifier-free guidance, resumable checkpoints.
+
+use super::run::{format_duration, Run};
+use super::tokens::{TokenBatch, TokenSet};
+use crate::model::generate::mask_schedule;
+use crate::model::transformer::{BaseTransformer, ResidualTransformer, TransformerConfig, PARTS};
+use crate::rng::Rng;
+use anyhow::Result;
+use burn::grad_clipping::GradientClippingConfig;
+use burn::optim::{AdamWConfig, GradientsParams};
+use burn::prelude::*;
+use burn::tensor::activation::log_softmax;
+use burn::tensor::{Int, TensorData};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Which transformer a run trains.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Base,
+    Residual,
+}
+
+/// Everything a transformer training run is configured by (saved as `config.json`).
+#[derive(Config, Debug)]
+pub struct TransformerTrainingConfig {
+    pub model: TransformerConfig,
+    #[config(default = 64)]
+    pub batch_size: usize,
+    #[config(default = 8000)]
+    pub steps: usize,
+    #[config(default = 2e-4)]
+    pub learning_rate: f64,
+    #[config(default = 1000)]
+    pub warmup_steps: usize,
+    /// Probability that a part is conditioned on its own sentence rather than the caption.
+    #[config(default = 0.3)]
+    pub part_text: f64,
+    /// Probability that a motion's text is dropped (for classifier-free guidance).
+    #[config(default = 0.1)]
+    pub drop_text: f64,
+    #[config(default = 0.1)]
+    pub label_smoothing: f64,
+    #[config(default = 5.0)]
+    pub checkpoint_minutes: f64,
+    #[config(default = 20)]
+    pub log_every: usize,
+    #[config(default = 4321)]
+    pub seed: u64,
+}
+
+/// Inputs and targets of one step.
+struct Step {
+    inputs: Tensor<3, Int>,
+    lower: Option<(Tensor<4, Int>, usize)>,
+    targets: Tensor<1, Int>,
+    /// 1 where a position counts in the loss.
+    weights: Tensor<1>,
+}
+
+/// Base: masks a cosine-scheduled fraction of each motion's layer-0 tokens (80 % become the
+/// mask id, 10 % a random code, 10 % stay), targets are the masked positions.
+fn base_step(
+    batch: &TokenBatch,
+    config: &TransformerConfig,
+    rng: &mut Rng,
+    device: &Device,
+) -> Step {
+    let (b, layers, n) = batch.dims;
+    let k = config.codebook_size;
+    let mut inputs = Vec::with_capacity(b * PARTS * n);
+    let mut targets = Vec::with_capacity(b * PARTS * n);
+    let mut weights = Vec::with_capacity(b * PARTS * n);
+    for (i, len) in batch.lengths.iter().enumerate() {
+        let real = PARTS * len;
+        let ratio = mask_schedule(rng.uniform() as f64);
+        let count = ((ratio * real as f64).ceil() as usize).clamp(1, real);
+        let mut order: Vec<usize> = (0..real).collect();
+        rng.shuffle(&mut order);
+        let mut masked = vec![false; real];
+        for o in order.into_iter().take(count) {
+            masked[o] = true;
+        }
+        for p in 0..PARTS {
+            let row =
+                &batch.tokens[((i * PARTS + p) * layers) * n..((i * PARTS + p) * layers) * n + n];
+            for (s, token) in row.iter().enumerate() {
+                let is_masked = s < *len && masked[p * len + s];
+                let input = if !is_masked {
+                    *token
+                } else {
+                    match rng.uniform() {
+                        u if u < 0.8 => config.mask_id() as i32,
+                        u if u < 0.9 => rng.below(k) as i32,
+                        _ => *token,
+                    }
+                };
+                inputs.push(input);
+                targets.push(if is_masked { *token } else { 0 });
+                weights.push(is_masked as u8 as f32);
+            }
+        }
+    }
+    Step {
+        inputs: Tensor::from_data(TensorData::new(inputs, [b, PARTS, n]), device),
+        lower: None,
+        targets: Tensor::from_data(TensorData::new(targets, [b * PARTS * n]), device),
+        weights: Tensor::from_data(TensorData::new(weights, [b * PARTS * n]), device),
+    }
+}
+
+/// Residual: a random layer `j ≥ 1` is the target everywhere the motion is real.
+fn residual_step(batch: &TokenBatch, rng: &mut Rng, device: &Device) -> Step {
+    let (b, layers, n) = batch.dims;
+    let j = 1 + rng.below(layers - 1);
+    let mut lower = Vec::with_capacity(b * PARTS * j * n);
+    let mut targets = Vec::with_capacity(b * PARTS * n);
+    let mut weights = Vec::with_capacity(b * PARTS * n);
+    for (i, len) in batch.lengths.iter().enumerate() {
+        for p in 0..PARTS {
+            let base = (i * PARTS + p) * layers * n;
+            lower.extend_from_slice(&batch.tokens[base..base + j * n]);
+            let row = &batch.tokens[base + j * n..base + (j + 1) * n];
+            targets.extend(
+                row.iter()
+                    .enumerate()
+                    .map(|(s, t)| if s < *len { *t } else { 0 }),
+            );
+            weights.extend((0..n).map(|s| (s < *len) as u8 as f32));
+        }
+    }
+    Step {
+        inputs: Tensor::from_data(
+            TensorData::new(vec![0i32; b * PARTS * n], [b, PARTS, n]),
+            device,
+        ),
+        lower: Some((
+            Tensor::from_data(TensorData::new(lower, [b, PARTS, j, n]), device),
+            j,
+        )),
+        targets: Tensor::from_data(TensorData::new(targets, [b * PARTS * n]), device),
+        weights: Tensor::from_data(TensorData::new(weights, [b * PARTS * n]), device),
+    }
+}
+
+/// Label-smoothed cross entropy over weighted positions, and the accuracy there.
+fn loss_and_accuracy(logits: Tensor<4>, step: &Step, smoothing: f64) -> (Tensor<1>, f64) {
+    let [b, p, n, k] = logits.dims();
+    let logp = log_softmax(logits.reshape([b * p * n, k]), 1);
+    let picked = logp
+        .clone()
+        .gather(1, step.targets.clone().reshape([b * p * n, 1]))
+        .reshape([b * p * n]);
+    let uniform = logp.clone().mean_dim(1).reshape([b * p * n]);
+    let per_position = (picked * (1.0 - smoothing) + uniform * smoothing).neg();
+    let count = step.weights.clone().sum().clamp_min(1.0);
+    let loss = (per_position * step.weights.clone()).sum() / count.clone();
+    let predicted = logp.argmax(1).reshape([b * p * n]);
+    let hits = predicted.equal(step.targets.clone()).float() * step.weights.clone();
+    let accuracy =
+        hits.sum().into_scalar::<f32>() as f64 / count.into_scalar::<f32>().max(1.0) as f64;
+    (loss, accuracy)
+}
+
+/// Options of one invocation.
+pub struct TransformerTrainOptions {
+    pub run_dir: PathBuf,
+    pub minutes: Option<f64>,
+}
+
+/// The two kinds of model behind one interface for the loop.
+#[derive(Module, Debug)]
+enum Model {
+    Base(BaseTransformer),
+    Residual(ResidualTransformer),
+}
+
+/// Trains (or resumes) a base or residual transformer run on a token set.
+pub fn train_transformer(
+    kind: Kind,
+    config: &TransformerTrainingConfig,
+    data: &TokenSet,
+    options: &TransformerTrainOptions,
+    device: &Device,
+    progress: &dyn Fn(&str),
+) -> Result<()> {
+    let (mut run, resumed) = Run::open(&options.run_dir, &["loss", "accuracy"])?;
+    config
+        .save(options.run_dir.join("config.json"))
+        .map_err(|e| anyhow::anyhow!("saving config.json: {e}"))?;
+    let mut model = match kind {
+        Kind::Base => Model::Base(BaseTransformer::new(&config.model, device)),
+        Kind::Residual => Model::Residual(ResidualTransformer::new(&config.model, device)),
+    };
+    let mut optim = AdamWConfig::new()
+        .with_weight_decay(1e-5)
+        .with_grad_clipping(Some(GradientClippingConfig::Norm(1.0)))
+        .init();
+    if resumed {
+        model = model
+            .try_load_file(run.checkpoint_file("model.bpk"))
+            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's model: {e:?}"))?;
+        optim = optim
+            .load(run.checkpoint_file("optim.bpk"))
+            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's optimizer: {e:?}"))?;
+        progress(&format!(
+            "resumed at step {} ({} trained)",
+            run.state.step,
+            format_duration(run.state.seconds)
+        ));
+    }
+    let epoch_steps = (data.items.len() as f64 / config.batch_size as f64).max(1.0);
+    let (samples_at_start, steps_at_start) = (run.state.samples, run.state.step);
+    let session = Instant::now();
+    let mut recent: Vec<[f64; 2]> = Vec::new();
+    while run.state.step < config.steps {
+        let step = run.state.step;
+        let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        let batch = data.batch(
+            &config.model,
+            &mut rng,
+            config.batch_size,
+            config.part_text as f32,
+            config.drop_text as f32,
+            device,
+        );
+        let inputs = match kind {
+            Kind::Base => base_step(&batch, &config.model, &mut rng, device),
+            Kind::Residual => residual_step(&batch, &mut rng, device),
+        };
+        let logits = match (&model, &inputs.lower) {
+            (Model::Base(m), _) => m.forward(
+                inputs.inputs.clone(),
+                batch.text.clone(),
+                batch.keep_text.clone(),
+                batch.pad.clone(),
+            ),
+            (Model::Residual(m), Some((lower, j))) => m.forward(
+                lower.clone(),
+                *j,
+                batch.text.clone(),
+                batch.keep_text.clone(),
+                batch.pad.clone(),
+            ),
+            (Model::Residual(_), None) => unreachable!("residual steps carry their lower layers"),
+        };
+        let (loss, accuracy) = loss_and_accuracy(logits, &inputs, config.label_smoothing);
+        let loss_value = loss.clone().into_scalar::<f32>() as f64;
+        let lr = config.learning_rate * ((step + 1) as f64 / config.warmup_steps as f64).min(1.0);
+        let grads = GradientsParams::from_grads(loss.backward(), &model);
+        model = optim.step(lr, model, grads);
+        run.record(config.batch_size, &[loss_value, accuracy])?;
+        recent.push([loss_value, accuracy]);
+
+        let done = run.state.step;
+        if done % config.log_every == 0 || done == config.steps {
+            let n = recent.len() as f64;
+            let mean: Vec<f64> = (0..2)
+                .map(|i| recent.iter().map(|r| r[i]).sum::<f64>() / n)
+                .collect();
+            recent.clear();
+            let seconds_per_step =
+                session.elapsed().as_secs_f64() / (done - steps_at_start).max(1) as f64;
+            let line = run.progress_line(
+                config.steps,
+                done as f64 / epoch_steps,
+                &mean,
+                run.samples_per_second(samples_at_start),
+                seconds_per_step,
+            );
+            progress(&line);
+        }
+        let out_of_time = options
+            .minutes
+            .is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
+        if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
+            run.checkpoint(|dir| {
+                model
+                    .clone()
+                    .save_file(dir.join("model.bpk"))
+                    .map_err(|e| anyhow::anyhow!("saving the model: {e:?}"))?;
+                optim
+                    .save(dir.join("optim.bpk"))
+                    .map_err(|e| anyhow::anyhow!("saving the optimizer: {e:?}"))?;
+                Ok(())
+            })?;
+            run.plot(
+                if kind == Kind::Base {
+                    "base transformer"
+                } else {
+                    "residual transformer"
+                },
+                20,
+            )?;
+            progress(&format!("checkpoint at step {done}"));
+        }
+        if out_of_time {
+            progress("time limit reached; run the same command again to resume");
+            break;
+        }
+    }
+    if run.state.step >= config.steps {
+        let weights = options.run_dir.join(if kind == Kind::Base {
+            "base.bpk"
+        } else {
+            "residual.bpk"
+        });
+        match model.valid() {
+            Model::Base(m) => m.save_file(&weights),
+            Model::Residual(m) => m.save_file(&weights),
+        }
+        .map_err(|e| anyhow::anyhow!("saving {}: {e:?}", weights.display()))?;
+        progress(&format!("finished: weights in {}", weights.display()));
+    }
+    Ok(())
+}

@@ -1,0 +1,302 @@
+//! Training the VQ-VAE (`coma train vq`): random crops of the training split, smooth-L1
+//! reconstruction plus position and velocity terms plus commitment, AdamW with warm-up,
+//! moving-average codebooks, resumable checkpoints, and the reconstruction error in millimetres
+//! on held-out motions.
+
+use super::motions::MotionSet;
+use super::run::{format_duration, Run};
+use crate::dataset::Split;
+use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM, POSITIONS};
+use crate::geom;
+use crate::model::vq::{MotionVq, VqConfig, DOWNSAMPLE};
+use crate::rng::Rng;
+use anyhow::{Context, Result};
+use burn::grad_clipping::GradientClippingConfig;
+use burn::nn::loss::SmoothL1LossConfig;
+use burn::optim::{AdamWConfig, GradientsParams};
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Everything a VQ training run is configured by (saved as the run's `config.json`).
+#[derive(Config, Debug)]
+pub struct VqTrainingConfig {
+    pub model: VqConfig,
+    /// Motions per step.
+    #[config(default = 64)]
+    pub batch_size: usize,
+    /// Longest crop in frames (at 20 fps); shorter motions train in batches of their length.
+    #[config(default = 64)]
+    pub max_frames: usize,
+    /// Total optimizer steps.
+    #[config(default = 5000)]
+    pub steps: usize,
+    #[config(default = 2e-4)]
+    pub learning_rate: f64,
+    /// Steps of linear learning-rate warm-up.
+    #[config(default = 500)]
+    pub warmup_steps: usize,
+    /// The learning rate is divided by 10 after this fraction of the steps.
+    #[config(default = 0.8)]
+    pub decay_at: f64,
+    /// Weight of the commitment loss (β).
+    #[config(default = 0.02)]
+    pub commitment: f64,
+    /// Weight of the extra term on root-relative joint positions.
+    #[config(default = 0.5)]
+    pub position_weight: f64,
+    /// Weight of the term on frame-to-frame changes of those positions.
+    #[config(default = 0.5)]
+    pub velocity_weight: f64,
+    #[config(default = 5.0)]
+    pub checkpoint_minutes: f64,
+    /// Steps between progress lines.
+    #[config(default = 20)]
+    pub log_every: usize,
+    /// Steps between validation passes.
+    #[config(default = 1000)]
+    pub eval_every: usize,
+    #[config(default = 1234)]
+    pub seed: u64,
+}
+
+/// Learning rate of a step: linear warm-up, then constant, then a tenth.
+fn learning_rate(config: &VqTrainingConfig, step: usize) -> f64 {
+    let base = config.learning_rate;
+    if step < config.warmup_steps {
+        base * (step + 1) as f64 / config.warmup_steps as f64
+    } else if (step as f64) < config.decay_at * config.steps as f64 {
+        base
+    } else {
+        base * 0.1
+    }
+}
+
+/// Flattened crops → `[B, T, 263]`.
+fn batch_tensor(data: Vec<f32>, b: usize, t: usize, device: &Device) -> Tensor<3> {
+    Tensor::from_data(TensorData::new(data, [b, t, FEATURE_DIM]), device)
+}
+
+/// Options of one invocation (not part of the run's configuration).
+pub struct VqTrainOptions {
+    pub data: PathBuf,
+    pub run_dir: PathBuf,
+    /// Stop after this many minutes (checkpointing first); the run resumes next time.
+    pub minutes: Option<f64>,
+}
+
+/// Trains (or resumes) a VQ-VAE run, printing progress through `progress`.
+pub fn train_vq(
+    config: &VqTrainingConfig,
+    options: &VqTrainOptions,
+    device: &Device,
+    progress: &dyn Fn(&str),
+) -> Result<()> {
+    let train = MotionSet::load(&options.data, Split::Train)?;
+    let val = MotionSet::load(&options.data, Split::Val)?;
+    progress(&format!(
+        "training on {} motions ({} frames), validating on {}",
+        train.items.len(),
+        train.frames(),
+        val.items.len()
+    ));
+    let (mut run, resumed) = Run::open(
+        &options.run_dir,
+        &["loss", "reconstruction", "commitment", "codes_reset"],
+    )?;
+    config
+        .save(options.run_dir.join("config.json"))
+        .context("saving config.json")?;
+
+    let mut model = config.model.init(device);
+    let mut optim = AdamWConfig::new()
+        .with_weight_decay(0.0)
+        .with_grad_clipping(Some(GradientClippingConfig::Norm(1.0)))
+        .init();
+    if resumed {
+        model = model
+            .try_load_file(run.checkpoint_file("model.bpk"))
+            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's model: {e:?}"))?;
+        optim = optim
+            .load(run.checkpoint_file("optim.bpk"))
+            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's optimizer: {e:?}"))?;
+        progress(&format!(
+            "resumed at step {} ({} trained)",
+            run.state.step,
+            format_duration(run.state.seconds)
+        ));
+    }
+
+    let smooth_l1 = SmoothL1LossConfig::new().init();
+    let epoch_steps =
+        (train.frames() as f64 / (config.batch_size * config.max_frames) as f64).max(1.0);
+    let samples_at_start = run.state.samples;
+    let steps_at_start = run.state.step;
+    let session = Instant::now();
+    let mut recent = Vec::new();
+    while run.state.step < config.steps {
+        let step = run.state.step;
+        // Each step's randomness depends only on the seed and the step, so a resumed run
+        // continues exactly as an uninterrupted one would.
+        let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        let crops = train.sample_crops(&mut rng, config.batch_size, config.max_frames, DOWNSAMPLE);
+        let x = batch_tensor(crops.data, crops.batch, crops.frames, device);
+
+        let out = model.forward_train(x.clone(), &config.model, &mut rng);
+        let recon = smooth_l1
+            .forward(out.reconstruction.clone(), x.clone())
+            .mean();
+        let pos_pred = out.reconstruction.clone().slice(s![.., .., POSITIONS]);
+        let pos_true = x.clone().slice(s![.., .., POSITIONS]);
+        let positions = smooth_l1.forward(pos_pred.clone(), pos_true.clone()).mean();
+        let t = crops.frames;
+        let vel_pred =
+            pos_pred.clone().slice(s![.., 1..t, ..]) - pos_pred.slice(s![.., 0..t - 1, ..]);
+        let vel_true =
+            pos_true.clone().slice(s![.., 1..t, ..]) - pos_true.slice(s![.., 0..t - 1, ..]);
+        let velocity = smooth_l1.forward(vel_pred, vel_true).mean();
+        let loss = recon.clone()
+            + positions * config.position_weight
+            + velocity * config.velocity_weight
+            + out.commitment.clone() * config.commitment;
+
+        let values = [
+            loss.clone().into_scalar::<f32>() as f64,
+            recon.into_scalar::<f32>() as f64,
+            out.commitment.clone().into_scalar::<f32>() as f64,
+        ];
+        let grads = GradientsParams::from_grads(loss.backward(), &model);
+        model = optim.step(learning_rate(config, step), model, grads);
+        let reset = model.update_codebooks(&out.assignments, config.model.ema_decay, &mut rng);
+        let logged = [values[0], values[1], values[2], reset as f64];
+        run.record(crops.batch, &logged)?;
+        recent.push(logged);
+
+        let done = run.state.step;
+        if done % config.log_every == 0 || done == config.steps {
+            let n = recent.len() as f64;
+            let mean: Vec<f64> = (0..4)
+                .map(|i| recent.iter().map(|r| r[i]).sum::<f64>() / n)
+                .collect();
+            recent.clear();
+            let seconds_per_step =
+                session.elapsed().as_secs_f64() / (done - steps_at_start).max(1) as f64;
+            let line = run.progress_line(
+                config.steps,
+                done as f64 / epoch_steps,
+                &mean,
+                run.samples_per_second(samples_at_start),
+                seconds_per_step,
+            );
+            progress(&line);
+        }
+        if done % config.eval_every == 0 || done == config.steps {
+            let mm = reconstruction_error_mm(
+                &model.valid(),
+                &val,
+                &device.clone().without_autodiff(),
+                64,
+            )?;
+            progress(&format!(
+                "step {done}: validation reconstruction error {mm:.1} mm (mean per-joint position)"
+            ));
+            append_eval(&options.run_dir, done, mm)?;
+        }
+        let out_of_time = options
+            .minutes
+            .is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
+        if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
+            save_checkpoint(&mut run, &model, &optim)?;
+            run.plot("VQ-VAE training", 20)?;
+            progress(&format!("checkpoint at step {done}"));
+        }
+        if out_of_time {
+            progress("time limit reached; run the same command again to resume");
+            break;
+        }
+    }
+    if run.state.step >= config.steps {
+        let weights = options.run_dir.join("vq.bpk");
+        model
+            .valid()
+            .save_file(&weights)
+            .map_err(|e| anyhow::anyhow!("saving {}: {e:?}", weights.display()))?;
+        progress(&format!("finished: weights in {}", weights.display()));
+    }
+    Ok(())
+}
+
+fn save_checkpoint(
+    run: &mut Run,
+    model: &MotionVq,
+    optim: &burn::optim::ModuleOptimizer,
+) -> Result<()> {
+    run.checkpoint(|dir| {
+        model
+            .clone()
+            .save_file(dir.join("model.bpk"))
+            .map_err(|e| anyhow::anyhow!("saving the model: {e:?}"))?;
+        optim
+            .save(dir.join("optim.bpk"))
+            .map_err(|e| anyhow::anyhow!("saving the optimizer: {e:?}"))?;
+        Ok(())
+    })
+}
+
+fn append_eval(dir: &Path, step: usize, mm: f64) -> Result<()> {
+    use std::io::Write;
+    let path = dir.join("eval.csv");
+    let fresh = !path.exists();
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)?;
+    if fresh {
+        writeln!(f, "step,val_mpjpe_mm")?;
+    }
+    writeln!(f, "{step},{mm:.3}")?;
+    Ok(())
+}
+
+/// Joint positions of normalised features.
+fn joints_of(normalized: &[FeatureFrame], normalizer: &Normalizer) -> Vec<crate::skeleton::Pose> {
+    features::features_to_joints(&normalizer.denormalize(normalized))
+}
+
+/// Mean per-joint position error (millimetres) of reconstructing up to `limit` motions of
+/// `set` whole (each cut to a multiple of 4 frames), joints recovered from the features.
+pub fn reconstruction_error_mm(
+    model: &MotionVq,
+    set: &MotionSet,
+    device: &Device,
+    limit: usize,
+) -> Result<f64> {
+    let mut total = 0.0;
+    let mut count = 0usize;
+    for item in set.items.iter().take(limit) {
+        let t = item.features.len() / DOWNSAMPLE * DOWNSAMPLE;
+        if t == 0 {
+            continue;
+        }
+        let frames = &item.features[..t];
+        let x = batch_tensor(frames.iter().flatten().copied().collect(), 1, t, device);
+        let y: Vec<f32> = model
+            .reconstruct(x)
+            .try_into_vec_as::<f32>()
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let recon: Vec<FeatureFrame> = y
+            .chunks_exact(FEATURE_DIM)
+            .map(|c| c.try_into().expect("263 columns"))
+            .collect();
+        let truth = joints_of(frames, &set.normalizer);
+        let guess = joints_of(&recon, &set.normalizer);
+        for (a, b) in truth.iter().zip(&guess) {
+            for (p, q) in a.iter().zip(b) {
+                total += geom::dist(*p, *q);
+                count += 1;
+            }
+        }
+    }
+    Ok(total / count.max(1) as f64 * 1000.0)
+}
