@@ -3,6 +3,7 @@
 //! Motions are 22-joint SMPL skeletons at 20 fps, Y up, metres, starting at the origin facing
 //! +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
 
+pub mod bench;
 pub mod bvh;
 pub mod dataset;
 pub mod features;

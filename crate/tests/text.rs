@@ -302,7 +302,10 @@ fn minilm_word_table_round_trips() {
 
 #[test]
 fn minilm_encode_time() {
-    let enc = encoder();
+    let start = std::time::Instant::now();
+    let enc = SentenceEncoder::from_dir(&models_dir(), &burn::prelude::Device::flex()).unwrap();
+    println!("loading the encoder takes {:?}", start.elapsed());
+    println!("{enc:?}");
     let text = "a person walks forward waving the left hand";
     enc.encode(&[text]); // warm-up: first-call allocations and thread pool start
     let runs = 10;
@@ -314,6 +317,13 @@ fn minilm_encode_time() {
     println!(
         "encoding one sentence ({} tokens) takes {per:?} on the CPU",
         enc.tokenizer().encode(text).len()
+    );
+    let batch = [text; 20];
+    let start = std::time::Instant::now();
+    std::hint::black_box(enc.encode(&batch));
+    println!(
+        "encoding 20 of them in one batch takes {:?}",
+        start.elapsed()
     );
 }
 

@@ -64,6 +64,63 @@ enum Command {
         #[command(subcommand)]
         command: TrainCommand,
     },
+    /// Generate a motion from a prompt with the default (or given) model.
+    Generate {
+        prompt: String,
+        /// Length in seconds (0.2 s steps, at most 9.8 s).
+        #[arg(long, default_value_t = 4.0)]
+        seconds: f64,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// A body part's own instruction, e.g. --part "left arm=waves the left hand".
+        #[arg(long = "part")]
+        parts: Vec<String>,
+        /// Motion file to write (.bvh, .npy features, .json joints).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Filmstrip PNG to write.
+        #[arg(long)]
+        png: Option<PathBuf>,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Edit a saved motion (.npy features): regenerate a time range or some body parts.
+    Edit {
+        /// Motion to edit (.npy features from `coma generate` or the dataset).
+        input: PathBuf,
+        /// What the edited range or parts should do.
+        #[arg(long)]
+        text: String,
+        /// Start of the range to regenerate, seconds (in-between edit).
+        #[arg(long)]
+        from: Option<f64>,
+        /// End of the range, seconds.
+        #[arg(long)]
+        to: Option<f64>,
+        /// Body parts to regenerate (body-part edit), e.g. --parts "left arm".
+        #[arg(long = "parts")]
+        parts: Vec<String>,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long)]
+        png: Option<PathBuf>,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Measure load, generation and training speed on this machine.
+    Bench {
+        /// Measure random weights of this size (a spam.json, e.g. configs/paper.json) instead of
+        /// the default model.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Timed training steps per network.
+        #[arg(long, default_value_t = 3)]
+        train_steps: usize,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
     /// The sentence encoder.
     Text {
         #[command(subcommand)]
@@ -163,6 +220,14 @@ struct TransformerArgs {
     steps: Option<usize>,
 }
 
+#[derive(clap::Args)]
+struct ModelArgs {
+    /// Folder with spam.json, vq.bpk, base.bpk, residual.bpk, mean.npy, std.npy and the
+    /// sentence encoder files.
+    #[arg(long, default_value = "static/models")]
+    models: PathBuf,
+}
+
 #[derive(Subcommand)]
 enum TextCommand {
     /// Convert all-MiniLM-L6-v2 (model.safetensors and vocab of the PyPI package
@@ -181,6 +246,70 @@ enum ViewArg {
     Front,
     Side,
     ThreeQuarter,
+}
+
+type Loaded = (
+    coma::model::Spam,
+    coma::features::Normalizer,
+    coma::text::minilm::SentenceEncoder,
+);
+
+/// SPAM and the sentence encoder from a model folder, on the CPU.
+fn load_model(dir: &std::path::Path) -> Result<Loaded> {
+    let device = burn::tensor::Device::flex();
+    let (spam, normalizer) = coma::model::Spam::load(dir, &device)?;
+    let text = coma::text::minilm::SentenceEncoder::from_dir(dir, &device)?;
+    Ok((spam, normalizer, text))
+}
+
+/// `--part "left arm=…"` arguments as per-part embeddings.
+fn parse_parts(
+    parts: &[String],
+    text: &coma::text::minilm::SentenceEncoder,
+) -> Result<Vec<(coma::skeleton::BodyPart, [f32; 384])>> {
+    parts
+        .iter()
+        .map(|p| {
+            let (name, instruction) = p.split_once('=').ok_or_else(|| anyhow::anyhow!("--part '{p}': expected 'left arm=instruction'"))?;
+            let part = coma::skeleton::BodyPart::parse(name)
+                .ok_or_else(|| anyhow::anyhow!("--part '{p}': unknown body part '{name}' (left arm, right arm, left leg, right leg)"))?;
+            Ok((part, text.encode(&[instruction.trim()])[0]))
+        })
+        .collect()
+}
+
+/// Writes the motion file and/or filmstrip of generated features.
+fn write_outputs(
+    features: &[coma::features::FeatureFrame],
+    out: Option<&std::path::Path>,
+    png: Option<&std::path::Path>,
+    title: &str,
+) -> Result<()> {
+    let motion = coma::motion_file::MotionData::Features(features.to_vec());
+    if let Some(path) = out {
+        write_motion(path, &motion, true)?;
+        println!(
+            "wrote {} ({} frames, {:.1} s)",
+            path.display(),
+            features.len(),
+            features.len() as f64 / coma::features::FPS
+        );
+    }
+    if let Some(path) = png {
+        let options = FilmstripOptions {
+            title: Some(title.to_string()),
+            ..FilmstripOptions::default()
+        };
+        coma::render::write_filmstrip(path, &motion.joints(), &options)?;
+        println!("wrote {}", path.display());
+    }
+    if out.is_none() && png.is_none() {
+        println!(
+            "generated {} frames; pass --out or --png to save them",
+            features.len()
+        );
+    }
+    Ok(())
 }
 
 /// Tokenizes the dataset with the trained VQ-VAE, embeds its texts, and trains a transformer.
@@ -349,6 +478,105 @@ fn run(cli: Cli) -> Result<()> {
         Command::Train {
             command: TrainCommand::Res(args),
         } => train_transformer(coma::train::transformer::Kind::Residual, args)?,
+        Command::Generate {
+            prompt,
+            seconds,
+            seed,
+            parts,
+            out,
+            png,
+            model,
+        } => {
+            let (spam, normalizer, text) = load_model(&model.models)?;
+            let global = text.encode(&[prompt.as_str()])[0];
+            let overrides = parse_parts(&parts, &text)?;
+            let condition = coma::model::edit::part_text(&global, &overrides);
+            let options = coma::model::generate::SamplingOptions {
+                seed,
+                ..Default::default()
+            };
+            let frames = (seconds * coma::features::FPS).round().max(4.0) as usize;
+            let tokens = spam.generate(&condition, frames, &options);
+            let features = normalizer.denormalize(&spam.decode(&tokens));
+            write_outputs(&features, out.as_deref(), png.as_deref(), &prompt)?;
+        }
+        Command::Edit {
+            input,
+            text: instruction,
+            from,
+            to,
+            parts,
+            seed,
+            out,
+            png,
+            model,
+        } => {
+            let (spam, normalizer, text) = load_model(&model.models)?;
+            let motion = match read_motion(&input)? {
+                coma::motion_file::MotionData::Features(f) => f,
+                _ => bail!(
+                    "{}: edit needs a .npy of features (as `coma generate --out m.npy` writes)",
+                    input.display()
+                ),
+            };
+            let tokens = spam.tokenize(&normalizer.normalize(&motion));
+            let embedding = text.encode(&[instruction.as_str()])[0];
+            let options = coma::model::generate::SamplingOptions {
+                seed,
+                ..Default::default()
+            };
+            let edited = match (from, to, parts.is_empty()) {
+                (Some(a), Some(b), true) => {
+                    let condition = coma::model::edit::part_text(&embedding, &[]);
+                    let fps = coma::features::FPS;
+                    spam.inbetween(
+                        &tokens,
+                        &condition,
+                        (a * fps) as usize,
+                        (b * fps).ceil() as usize,
+                        &options,
+                    )
+                }
+                (None, None, false) => {
+                    let chosen = parts
+                        .iter()
+                        .map(|p| {
+                            coma::skeleton::BodyPart::parse(p)
+                                .ok_or_else(|| anyhow::anyhow!("unknown body part '{p}' (left arm, right arm, left leg, right leg)"))
+                        })
+                        .collect::<Result<Vec<_>>>()?;
+                    let overrides: Vec<_> = chosen.iter().map(|p| (*p, embedding)).collect();
+                    // The other parts keep doing what the motion does, as the describer puts it.
+                    let description = coma::posecodes::describe_motion(
+                        &coma::features::features_to_joints(&motion),
+                    );
+                    let rest = text.encode(&[description.as_str()])[0];
+                    let condition = coma::model::edit::part_text(&rest, &overrides);
+                    spam.edit_parts(&tokens, &condition, &chosen, &options)
+                }
+                _ => bail!(
+                    "give either --from and --to (in-between edit) or --parts (body-part edit)"
+                ),
+            };
+            let features = normalizer.denormalize(&spam.decode(&edited));
+            write_outputs(&features, Some(&out), png.as_deref(), &instruction)?;
+        }
+        Command::Bench {
+            config,
+            train_steps,
+            model,
+        } => {
+            use burn::config::Config;
+            let sizes = match config {
+                Some(path) => Some(
+                    coma::model::SpamConfig::load(&path)
+                        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?,
+                ),
+                None => None,
+            };
+            let rows = coma::bench::run_bench(&model.models, sizes.as_ref(), train_steps)?;
+            print!("{}", coma::bench::table(&rows));
+        }
         Command::Text {
             command: TextCommand::Convert { from, out },
         } => {

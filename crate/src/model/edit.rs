@@ -21,6 +21,17 @@ use burn::tensor::{Int, TensorData};
 /// The text condition of each part (model order: left arm, right arm, left leg, right leg).
 pub type PartText = [[f32; TEXT_DIM]; PARTS];
 
+/// The condition of every part: the global prompt's embedding, replaced for the parts that
+/// have their own instruction.
+pub fn part_text(global: &[f32; TEXT_DIM], overrides: &[(BodyPart, [f32; TEXT_DIM])]) -> PartText {
+    std::array::from_fn(|p| {
+        overrides
+            .iter()
+            .find(|(part, _)| *part == BodyPart::ALL[p])
+            .map_or(*global, |(_, e)| *e)
+    })
+}
+
 /// Fraction of the other parts' tokens re-generated in a body-part edit.
 pub const PART_EDIT_CONTEXT: f32 = 0.1;
 
@@ -162,6 +173,30 @@ impl Spam {
                         row.extend(&window[p][l]);
                         row.extend(&b[p][l][end_b..]);
                         row
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Tokens of normalised features (cut to a multiple of 4 frames).
+    pub fn tokenize(&self, features: &[FeatureFrame]) -> MotionTokens {
+        let t = (features.len() / DOWNSAMPLE * DOWNSAMPLE).max(DOWNSAMPLE);
+        let mut flat: Vec<f32> = features.iter().take(t).flatten().copied().collect();
+        flat.resize(t * FEATURE_DIM, 0.0);
+        let x = Tensor::<3>::from_data(TensorData::new(flat, [1, t, FEATURE_DIM]), &self.device);
+        self.vq
+            .tokenize(x)
+            .into_iter()
+            .map(|layers| {
+                layers
+                    .into_iter()
+                    .map(|l| {
+                        l.try_into_vec_as::<i64>()
+                            .expect("int tokens")
+                            .into_iter()
+                            .map(|v| v as u32)
+                            .collect()
                     })
                     .collect()
             })

@@ -232,7 +232,7 @@ impl ResidualQuantizer {
         let [_, k, d] = self.codebooks.val().dims();
         self.codebooks
             .val()
-            .slice([layer..layer + 1])
+            .narrow(0, layer, 1)
             .reshape([k, d])
             .detach()
     }
@@ -293,13 +293,13 @@ impl ResidualQuantizer {
             let old_counts = self
                 .ema_counts
                 .val()
-                .slice([layer..layer + 1])
+                .narrow(0, layer, 1)
                 .reshape([k])
                 .detach();
             let old_sums = self
                 .ema_sums
                 .val()
-                .slice([layer..layer + 1])
+                .narrow(0, layer, 1)
                 .reshape([k, d])
                 .detach();
             let Some(a) = assignments.get(layer) else {

@@ -832,7 +832,7 @@ fn fill_rect(pm: &mut Pixmap, x: f32, y: f32, w: f32, h: f32, c: [u8; 3]) {
 }
 
 /// Draws `text` turned a quarter turn anticlockwise (read bottom to top), as a y axis label:
-/// the glyph tops face `x`, the left and the text starts at `bottom`.
+/// the glyph tops face left towards `x` and the text starts at `bottom`.
 fn draw_text_up(pm: &mut Pixmap, text: &str, x: f32, bottom: f32, s: u32, c: [u8; 3]) {
     let mut paint = Paint::default();
     paint.set_color_rgba8(c[0], c[1], c[2], 255);

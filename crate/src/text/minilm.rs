@@ -20,9 +20,10 @@ use burn::module::Module;
 use burn::nn::attention::{MhaInput, MultiHeadAttention, MultiHeadAttentionConfig};
 use burn::nn::{Embedding, EmbeddingConfig, LayerNorm, LayerNormConfig, Linear, LinearConfig};
 use burn::prelude::*;
+use burn::store::burn_pack::Tensor as PackTensor;
 use burn::store::{
-    BurnpackStore, HalfPrecisionAdapter, KeyRemapper, ModuleSnapshot, PyTorchToBurnAdapter,
-    SafetensorsStore,
+    BurnpackStore, HalfPrecisionAdapter, KeyRemapper, ModuleAdapter, ModuleContext, ModuleSnapshot,
+    PyTorchToBurnAdapter, SafetensorsStore,
 };
 use burn::tensor::activation::gelu;
 use burn::tensor::Bytes;
@@ -31,11 +32,11 @@ use std::path::{Path, PathBuf};
 /// Width of the sentence embeddings and token states.
 pub const EMBEDDING_DIM: usize = 384;
 
-/// File names [`convert_minilm`] writes and [`SentenceEncoder::from_dir`] reads.
+/// The vocabulary (HF's `vocab.txt` as is) that [`SentenceEncoder::from_dir`] reads.
 pub const VOCAB_FILE: &str = "minilm-vocab.txt";
-/// The int8 word-embedding table (see [`WordEmbeddings`]).
+/// The int8 word-embedding table (see [`WordEmbeddings`]) written by [`convert_minilm`].
 pub const WORDS_FILE: &str = "minilm-words.i8";
-/// The burnpack of the rest of the encoder.
+/// The burnpack of the rest of the encoder ([`MiniLm`]) written by [`convert_minilm`].
 pub const MODEL_FILE: &str = "minilm.bpk";
 
 /// Shape of the encoder; the defaults are all-MiniLM-L6-v2's `config.json`.
@@ -172,7 +173,8 @@ impl MiniLm {
     }
 
     /// Loads an encoder from burnpack bytes written by [`convert_minilm`] (f16 weights,
-    /// widened to f32). Fails, without panicking, on bytes that are not such a file.
+    /// widened to f32). Damaged bytes give an error, not a panic (checked for empty, garbage
+    /// and truncated input).
     pub fn from_bytes(bytes: &[u8], device: &Device) -> Result<MiniLm, MiniLmError> {
         let mut model = MiniLmConfig::new().init(device);
         let mut store = BurnpackStore::from_bytes(Some(Bytes::from_bytes_vec(bytes.to_vec())))
@@ -187,7 +189,7 @@ impl MiniLm {
     /// download is half the size; the encoder's outputs move by less than 1e-3 in cosine).
     pub fn to_bytes(&self) -> Result<Vec<u8>, MiniLmError> {
         let mut store = BurnpackStore::from_bytes(None)
-            .with_to_adapter(HalfPrecisionAdapter::new())
+            .with_to_adapter(HalfPrecisionAdapter::new().chain(ForgetParamIds))
             .metadata("model", "all-MiniLM-L6-v2 without word embeddings");
         self.save_into(&mut store)
             .map_err(|e| MiniLmError::Model(e.to_string()))?;
@@ -195,6 +197,23 @@ impl MiniLm {
             .get_bytes()
             .map_err(|e| MiniLmError::Model(e.to_string()))?;
         Ok(bytes.to_vec())
+    }
+}
+
+/// Drops the parameter ids from saved tensors. They are random per process and only matter to
+/// resume training; without them a conversion gives the same bytes every time, so the
+/// committed files can be checked against a fresh conversion.
+#[derive(Clone, Debug)]
+struct ForgetParamIds;
+
+impl ModuleAdapter for ForgetParamIds {
+    fn adapt(&self, mut tensor: PackTensor, _ctx: ModuleContext<'_>) -> PackTensor {
+        tensor.param_id = None;
+        tensor
+    }
+
+    fn clone_box(&self) -> Box<dyn ModuleAdapter> {
+        Box::new(self.clone())
     }
 }
 
@@ -258,7 +277,7 @@ pub enum WordsFormatError {
 /// | 12 | 4 | `u32` cols |
 /// | 16 | 4 × rows | `f32` scale of each row |
 /// | 16 + 4 × rows | rows × cols | `i8` values, row-major |
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct WordEmbeddings {
     rows: usize,
     cols: usize,
@@ -281,7 +300,7 @@ impl WordEmbeddings {
         assert_eq!(table.len(), rows * cols, "table is not rows × cols");
         let mut scales = Vec::with_capacity(rows);
         let mut values = Vec::with_capacity(rows * cols);
-        for row in table.chunks_exact(cols.max(1)).take(rows) {
+        for row in (0..rows).map(|r| &table[r * cols..(r + 1) * cols]) {
             let max = row.iter().fold(0f32, |m, v| m.max(v.abs()));
             let scale = max / 127.0;
             scales.push(scale);
@@ -382,13 +401,33 @@ impl WordEmbeddings {
     }
 }
 
+// By hand: the derived form would print millions of table entries.
+impl std::fmt::Debug for WordEmbeddings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WordEmbeddings")
+            .field("rows", &self.rows)
+            .field("cols", &self.cols)
+            .finish_non_exhaustive()
+    }
+}
+
 /// all-MiniLM-L6-v2 end to end: tokenizer, int8 word table and burn encoder on one device.
-#[derive(Debug)]
 pub struct SentenceEncoder {
     tokenizer: Tokenizer,
     words: WordEmbeddings,
     model: MiniLm,
     device: Device,
+}
+
+// By hand: the derived form would print the whole vocabulary.
+impl std::fmt::Debug for SentenceEncoder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SentenceEncoder")
+            .field("vocab_size", &self.tokenizer.vocab_size())
+            .field("words", &self.words)
+            .field("device", &self.device)
+            .finish_non_exhaustive()
+    }
 }
 
 impl SentenceEncoder {

@@ -11,6 +11,9 @@ use burn::prelude::*;
 use burn::tensor::{Bool, Int, TensorData};
 use std::collections::HashMap;
 
+/// Turns a batch of texts into one sentence embedding each.
+pub type TextEmbedder<'a> = &'a dyn Fn(&[&str]) -> Result<Vec<[f32; TEXT_DIM]>>;
+
 /// One motion as tokens and text.
 #[derive(Clone, Debug)]
 pub struct TokenItem {
@@ -54,7 +57,7 @@ impl TokenSet {
         set: &MotionSet,
         vq: &MotionVq,
         device: &Device,
-        embed: &dyn Fn(&[&str]) -> Result<Vec<[f32; TEXT_DIM]>>,
+        embed: TextEmbedder,
         progress: &dyn Fn(&str),
     ) -> Result<TokenSet> {
         let mut texts: Vec<String> = Vec::new();
