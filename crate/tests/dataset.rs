@@ -172,3 +172,82 @@ fn missing_archive_gives_a_clear_error() {
     assert!(format!("{err:#}").contains("nope.tar.xz"), "{err:#}");
     assert!(!tmp.path().join("out").exists());
 }
+
+#[test]
+fn training_loads_the_split_crops_it_and_resumes_a_run() {
+    use burn::prelude::*;
+    use coma::dataset::Split;
+    use coma::model::vq::VqConfig;
+    use coma::rng::Rng;
+    use coma::train::motions::MotionSet;
+    use coma::train::vq::{train_vq, VqTrainOptions, VqTrainingConfig};
+
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("bandai");
+    build(
+        &BuildOptions {
+            source: archive(),
+            out: out.clone(),
+            limit: Some(12),
+        },
+        &|_| {},
+    )
+    .unwrap();
+    let set = MotionSet::load(&out, Split::Train).unwrap();
+    let mut rng = Rng::new(3);
+    for _ in 0..10 {
+        let crops = set.sample_crops(&mut rng, 8, 64, 4);
+        assert_eq!(crops.frames % 4, 0);
+        assert!(crops.frames <= 64 && crops.frames >= 20);
+        assert_eq!(crops.data.len(), 8 * crops.frames * FEATURE_DIM);
+    }
+
+    let model = VqConfig::new()
+        .with_encoder_width(8)
+        .with_decoder_width(8)
+        .with_code_dim(4)
+        .with_codebook_size(8)
+        .with_layers(2)
+        .with_res_blocks(1);
+    let config = VqTrainingConfig::new(model)
+        .with_batch_size(4)
+        .with_max_frames(16)
+        .with_steps(3)
+        .with_eval_every(3)
+        .with_log_every(1);
+    let run = tmp.path().join("run");
+    let options = VqTrainOptions {
+        data: out.clone(),
+        run_dir: run.clone(),
+        minutes: None,
+    };
+    let lines = std::sync::Mutex::new(Vec::new());
+    let device = Device::flex().autodiff();
+    train_vq(&config.clone().with_steps(2), &options, &device, &|l| {
+        lines.lock().unwrap().push(l.to_string())
+    })
+    .unwrap();
+    assert!(run.join("checkpoint/model.bpk").exists() && run.join("losses.png").exists());
+    train_vq(&config, &options, &device, &|l| {
+        lines.lock().unwrap().push(l.to_string())
+    })
+    .unwrap();
+    let lines = lines.into_inner().unwrap();
+    assert!(
+        lines.iter().any(|l| l.contains("resumed at step 2")),
+        "{lines:?}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.contains("samples/s") && l.contains("ETA")),
+        "{lines:?}"
+    );
+    assert!(
+        lines.iter().any(|l| l.contains("empty validation split")),
+        "{lines:?}"
+    );
+    assert!(run.join("vq.bpk").exists());
+    let log = std::fs::read_to_string(run.join("log.csv")).unwrap();
+    assert_eq!(log.lines().count(), 4, "header and three steps:\n{log}");
+}

@@ -117,7 +117,8 @@ impl TokenSet {
         })
     }
 
-    /// A random batch of `batch` motions. Each part's condition is the motion's own sentence
+    /// A random batch of `batch` motions of similar length (between ¾ of and the length of
+    /// a randomly drawn one). Each part's condition is the motion's own sentence
     /// for that part with probability `part_text`, else one of its global captions (the same
     /// for all parts that use it); the whole text is dropped with probability `drop_text`.
     pub fn batch(
@@ -129,9 +130,22 @@ impl TokenSet {
         drop_text: f32,
         device: &Device,
     ) -> TokenBatch {
-        let picks: Vec<&TokenItem> = (0..batch)
-            .map(|_| &self.items[rng.below(self.items.len())])
-            .collect();
+        // Motions of similar length go together, so little of the batch is padding.
+        let anchor = self.items[rng.below(self.items.len())].tokens[0][0].len();
+        let similar = |len: usize| len <= anchor && len * 4 >= anchor * 3;
+        let mut picks: Vec<&TokenItem> = Vec::with_capacity(batch);
+        for _ in 0..batch * 50 {
+            if picks.len() == batch {
+                break;
+            }
+            let item = &self.items[rng.below(self.items.len())];
+            if similar(item.tokens[0][0].len()) {
+                picks.push(item);
+            }
+        }
+        while picks.len() < batch {
+            picks.push(&self.items[rng.below(self.items.len())]);
+        }
         let lengths: Vec<usize> = picks.iter().map(|i| i.tokens[0][0].len()).collect();
         let n = lengths.iter().copied().max().unwrap_or(1);
         let layers = picks[0].tokens[0].len();

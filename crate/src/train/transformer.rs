@@ -316,3 +316,107 @@ pub fn train_transformer(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::transformer::TEXT_DIM;
+    use crate::train::tokens::TokenItem;
+
+    fn tiny_set() -> TokenSet {
+        let mut rng = Rng::new(9);
+        let items = (0..12)
+            .map(|i| {
+                let n = 3 + i % 5;
+                TokenItem {
+                    tokens: (0..PARTS)
+                        .map(|_| {
+                            (0..3)
+                                .map(|_| (0..n).map(|_| rng.below(16) as u32).collect())
+                                .collect()
+                        })
+                        .collect(),
+                    captions: vec![i % 3],
+                    parts: [Some(3), None, None, Some(4)],
+                }
+            })
+            .collect();
+        let texts: Vec<String> = (0..5).map(|i| format!("text {i}")).collect();
+        let embeddings = (0..5).map(|i| [i as f32 * 0.1; TEXT_DIM]).collect();
+        TokenSet {
+            items,
+            texts,
+            embeddings,
+        }
+    }
+
+    fn config() -> TransformerTrainingConfig {
+        let model = TransformerConfig::new()
+            .with_width(16)
+            .with_depth(1)
+            .with_heads(2)
+            .with_ff_width(32)
+            .with_codebook_size(16)
+            .with_vq_layers(3)
+            .with_max_steps(8);
+        TransformerTrainingConfig::new(model)
+            .with_batch_size(4)
+            .with_steps(3)
+            .with_warmup_steps(1)
+            .with_log_every(1)
+    }
+
+    #[test]
+    fn batches_pad_similar_lengths_and_masking_targets_only_masked_tokens() {
+        let set = tiny_set();
+        let cfg = config();
+        let device = Device::flex();
+        let mut rng = Rng::new(1);
+        let batch = set.batch(&cfg.model, &mut rng, 4, 0.3, 0.1, &device);
+        let (b, layers, n) = batch.dims;
+        assert_eq!((b, layers), (4, 3));
+        assert_eq!(n, *batch.lengths.iter().max().unwrap());
+        assert_eq!(batch.tokens.len(), b * PARTS * layers * n);
+        let step = base_step(&batch, &cfg.model, &mut rng, &device);
+        let weights: Vec<f32> = step.weights.try_into_vec_as::<f32>().unwrap();
+        let inputs: Vec<i64> = step.inputs.try_into_vec_as::<i64>().unwrap();
+        assert!(weights.iter().any(|w| *w == 1.0));
+        // Unmasked positions keep their token; padding is never a target.
+        for (i, w) in weights.iter().enumerate() {
+            let (item, s) = (i / (PARTS * n), i % n);
+            if s >= batch.lengths[item] {
+                assert_eq!(*w, 0.0);
+                assert_eq!(inputs[i], cfg.model.pad_id() as i64);
+            }
+        }
+    }
+
+    #[test]
+    fn base_and_residual_runs_train_and_save_weights() {
+        let set = tiny_set();
+        let device = Device::flex().autodiff();
+        for kind in [Kind::Base, Kind::Residual] {
+            let tmp = tempfile::tempdir().unwrap();
+            let options = TransformerTrainOptions {
+                run_dir: tmp.path().to_path_buf(),
+                minutes: None,
+            };
+            let lines = std::sync::Mutex::new(Vec::new());
+            train_transformer(kind, &config(), &set, &options, &device, &|l| {
+                lines.lock().unwrap().push(l.to_string())
+            })
+            .unwrap();
+            let name = if kind == Kind::Base {
+                "base.bpk"
+            } else {
+                "residual.bpk"
+            };
+            assert!(tmp.path().join(name).exists());
+            assert!(lines
+                .into_inner()
+                .unwrap()
+                .iter()
+                .any(|l| l.contains("accuracy")));
+        }
+    }
+}

@@ -94,12 +94,17 @@ pub fn train_vq(
     progress: &dyn Fn(&str),
 ) -> Result<()> {
     let train = MotionSet::load(&options.data, Split::Train)?;
-    let val = MotionSet::load(&options.data, Split::Val)?;
+    // A small dataset may have no validation motions; training goes on without validation.
+    let val = MotionSet::load(&options.data, Split::Val).ok();
     progress(&format!(
         "training on {} motions ({} frames), validating on {}",
         train.items.len(),
         train.frames(),
-        val.items.len()
+        val.as_ref()
+            .map_or("nothing (empty validation split)".to_string(), |v| format!(
+                "{} motions",
+                v.items.len()
+            ))
     ));
     let (mut run, resumed) = Run::open(
         &options.run_dir,
@@ -191,10 +196,11 @@ pub fn train_vq(
             );
             progress(&line);
         }
-        if done % config.eval_every == 0 || done == config.steps {
+        let eval_due = done % config.eval_every == 0 || done == config.steps;
+        if let Some(val) = val.as_ref().filter(|_| eval_due) {
             let mm = reconstruction_error_mm(
                 &model.valid(),
-                &val,
+                val,
                 &device.clone().without_autodiff(),
                 64,
             )?;
