@@ -380,7 +380,7 @@ mod tests {
         let step = base_step(&batch, &cfg.model, &mut rng, &device);
         let weights: Vec<f32> = step.weights.try_into_vec_as::<f32>().unwrap();
         let inputs: Vec<i64> = step.inputs.try_into_vec_as::<i64>().unwrap();
-        assert!(weights.iter().any(|w| *w == 1.0));
+        assert!(weights.contains(&1.0));
         // Unmasked positions keep their token; padding is never a target.
         for (i, w) in weights.iter().enumerate() {
             let (item, s) = (i / (PARTS * n), i % n);
