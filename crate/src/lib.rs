@@ -6,6 +6,7 @@
 pub mod bench;
 pub mod bvh;
 pub mod dataset;
+pub mod eval;
 pub mod features;
 pub mod geom;
 pub mod model;

@@ -109,6 +109,28 @@ enum Command {
         #[command(flatten)]
         model: ModelArgs,
     },
+    /// Assemble trained runs into a model folder (the default model lives in static/models).
+    Export {
+        /// VQ-VAE run folder (with vq.bpk and config.json).
+        #[arg(long, default_value = "runs/vq")]
+        vq: PathBuf,
+        /// Base transformer run folder.
+        #[arg(long, default_value = "runs/base")]
+        base: PathBuf,
+        /// Residual transformer run folder.
+        #[arg(long, default_value = "runs/res")]
+        res: PathBuf,
+        /// Dataset whose Mean.npy/Std.npy normalised the training data.
+        #[arg(long, default_value = "data/bandai")]
+        data: PathBuf,
+        #[arg(long, default_value = "static/models")]
+        out: PathBuf,
+    },
+    /// Control probes of the model.
+    Probe {
+        #[command(subcommand)]
+        command: ProbeCommand,
+    },
     /// Measure load, generation and training speed on this machine.
     Bench {
         /// Measure random weights of this size (a spam.json, e.g. configs/paper.json) instead of
@@ -220,6 +242,34 @@ struct TransformerArgs {
     steps: Option<usize>,
 }
 
+#[derive(Subcommand)]
+enum ProbeCommand {
+    /// Raise and wave each hand over many seeds: how often the asked wrist ends higher.
+    Leftright {
+        #[arg(long, default_value_t = 20)]
+        seeds: u64,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Edit the left arm of a walk: how much the legs move, what the arm does.
+    Locality {
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Blend two segments: speeds at the join against real motion's 99th percentile.
+    Continuity {
+        /// Dataset whose test motions give the reference speeds.
+        #[arg(long, default_value = "data/bandai")]
+        data: PathBuf,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+}
+
 #[derive(clap::Args)]
 struct ModelArgs {
     /// Folder with spam.json, vq.bpk, base.bpk, residual.bpk, mean.npy, std.npy and the
@@ -246,6 +296,73 @@ enum ViewArg {
     Front,
     Side,
     ThreeQuarter,
+}
+
+/// Runs a control probe and prints its figures.
+fn probe(command: ProbeCommand) -> Result<()> {
+    use coma::eval::probes::{continuity, edit_locality, left_right, Generator};
+    let models = match &command {
+        ProbeCommand::Leftright { model, .. }
+        | ProbeCommand::Locality { model, .. }
+        | ProbeCommand::Continuity { model, .. } => model.models.clone(),
+    };
+    let (spam, normalizer, text) = load_model(&models)?;
+    let generator = Generator {
+        spam: &spam,
+        text: &text,
+        normalizer: &normalizer,
+    };
+    match command {
+        ProbeCommand::Leftright { seeds, .. } => {
+            let report = left_right(&generator, seeds, 4.0);
+            for (prompt, good, total) in &report.prompts {
+                println!("{prompt:<34} {good}/{total}");
+            }
+            println!("left/right correct: {:.1} %", report.rate * 100.0);
+        }
+        ProbeCommand::Locality { seed, .. } => {
+            let r = edit_locality(
+                &generator,
+                "a person walks forward",
+                "the person waves the left hand above the head",
+                seed,
+            );
+            println!(
+                "mean leg-joint change after a left-arm edit: {:.2} cm",
+                r.leg_change_cm
+            );
+            println!(
+                "left wrist rises {:.1} cm more after the edit",
+                r.left_wrist_rise_gain_cm
+            );
+        }
+        ProbeCommand::Continuity { data, seed, .. } => {
+            let set = coma::train::motions::MotionSet::load(&data, coma::dataset::Split::Test)?;
+            let reference: Vec<_> = set
+                .items
+                .iter()
+                .map(|i| {
+                    coma::features::features_to_joints(&set.normalizer.denormalize(&i.features))
+                })
+                .collect();
+            let r = continuity(
+                &generator,
+                "a person walks forward",
+                "a person bows",
+                &reference,
+                seed,
+            );
+            println!(
+                "join: root {:.2} m/s (99th percentile of real motion {:.2}), fastest joint {:.2} m/s (99th percentile {:.2}): {}",
+                r.join_root_speed,
+                r.p99_root_speed,
+                r.join_joint_speed,
+                r.p99_joint_speed,
+                if r.passes() { "no jump" } else { "JUMP" }
+            );
+        }
+    }
+    Ok(())
 }
 
 type Loaded = (
@@ -576,6 +693,46 @@ fn run(cli: Cli) -> Result<()> {
             };
             let rows = coma::bench::run_bench(&model.models, sizes.as_ref(), train_steps)?;
             print!("{}", coma::bench::table(&rows));
+        }
+        Command::Probe { command } => probe(command)?,
+        Command::Export {
+            vq,
+            base,
+            res,
+            data,
+            out,
+        } => {
+            use burn::config::Config;
+            let load = |p: PathBuf| -> Result<serde_json::Value> {
+                Ok(serde_json::from_str(
+                    &std::fs::read_to_string(&p)
+                        .with_context(|| format!("cannot read {}", p.display()))?,
+                )?)
+            };
+            let spam = serde_json::json!({
+                "vq": load(vq.join("config.json"))?["model"],
+                "base": load(base.join("config.json"))?["model"],
+                "residual": load(res.join("config.json"))?["model"],
+            });
+            std::fs::create_dir_all(&out)?;
+            // Parse it back so a wrong field fails here rather than in the page.
+            let text = serde_json::to_string_pretty(&spam)?;
+            std::fs::write(out.join("spam.json"), &text)?;
+            coma::model::SpamConfig::load(out.join("spam.json"))
+                .map_err(|e| anyhow::anyhow!("spam.json: {e}"))?;
+            for (from, to) in [
+                (vq.join("vq.bpk"), "vq.bpk"),
+                (base.join("base.bpk"), "base.bpk"),
+                (res.join("residual.bpk"), "residual.bpk"),
+                (data.join("Mean.npy"), "mean.npy"),
+                (data.join("Std.npy"), "std.npy"),
+            ] {
+                std::fs::copy(&from, out.join(to))
+                    .with_context(|| format!("copying {}", from.display()))?;
+            }
+            let device = burn::tensor::Device::flex();
+            coma::model::Spam::load(&out, &device)?;
+            println!("exported SPAM into {}", out.display());
         }
         Command::Text {
             command: TextCommand::Convert { from, out },

@@ -1,0 +1,294 @@
+//! Control probes: does the model do what was asked where it was asked?
+//!
+//! - left/right: over many seeds, raising or waving the left (right) hand must lift the left
+//!   (right) wrist higher than the other;
+//! - edit locality: editing one arm of a motion must leave the legs where they were;
+//! - continuity: the join of two blended segments must not be faster than real motion ever is.
+
+use crate::features::{self, FeatureFrame, Normalizer, FPS};
+use crate::geom;
+use crate::model::edit::{part_text, PartText};
+use crate::model::generate::{MotionTokens, SamplingOptions};
+use crate::model::Spam;
+use crate::skeleton::{joint, BodyPart, Pose};
+use crate::text::minilm::SentenceEncoder;
+
+/// SPAM with its text encoder and feature statistics: what a probe needs to generate.
+pub struct Generator<'a> {
+    pub spam: &'a Spam,
+    pub text: &'a SentenceEncoder,
+    pub normalizer: &'a Normalizer,
+}
+
+impl Generator<'_> {
+    fn condition(&self, prompt: &str) -> PartText {
+        part_text(&self.text.encode(&[prompt])[0], &[])
+    }
+
+    /// Joint positions of tokens.
+    pub fn joints(&self, tokens: &MotionTokens) -> Vec<Pose> {
+        features::features_to_joints(&self.features(tokens))
+    }
+
+    /// Features (not normalised) of tokens.
+    pub fn features(&self, tokens: &MotionTokens) -> Vec<FeatureFrame> {
+        self.normalizer.denormalize(&self.spam.decode(tokens))
+    }
+}
+
+/// Result of the left/right probe.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LeftRightReport {
+    /// Per prompt: how many samples lifted the asked wrist higher, out of how many.
+    pub prompts: Vec<(String, usize, usize)>,
+    /// Overall rate of correct samples.
+    pub rate: f64,
+}
+
+/// The highest the wrist gets above its own starting height, in metres.
+fn wrist_rise(poses: &[Pose], wrist: usize) -> f64 {
+    let start = poses.first().map_or(0.0, |p| p[wrist][1]);
+    poses
+        .iter()
+        .map(|p| p[wrist][1] - start)
+        .fold(f64::MIN, f64::max)
+}
+
+/// Raises and waves each hand with `seeds` seeds each; a sample is correct when the asked
+/// wrist rises more than the other one.
+pub fn left_right(generator: &Generator, seeds: u64, seconds: f64) -> LeftRightReport {
+    let prompts = [
+        (
+            "a person raises the left hand",
+            joint::L_WRIST,
+            joint::R_WRIST,
+        ),
+        (
+            "a person raises the right hand",
+            joint::R_WRIST,
+            joint::L_WRIST,
+        ),
+        (
+            "a person waves the left hand",
+            joint::L_WRIST,
+            joint::R_WRIST,
+        ),
+        (
+            "a person waves the right hand",
+            joint::R_WRIST,
+            joint::L_WRIST,
+        ),
+    ];
+    let frames = (seconds * FPS) as usize;
+    let mut rows = Vec::new();
+    let (mut good, mut total) = (0, 0);
+    for (prompt, asked, other) in prompts {
+        let condition = generator.condition(prompt);
+        let correct = (0..seeds)
+            .filter(|seed| {
+                let tokens = generator.spam.generate(
+                    &condition,
+                    frames,
+                    &SamplingOptions {
+                        seed: *seed,
+                        ..Default::default()
+                    },
+                );
+                let poses = generator.joints(&tokens);
+                wrist_rise(&poses, asked) > wrist_rise(&poses, other)
+            })
+            .count();
+        good += correct;
+        total += seeds as usize;
+        rows.push((prompt.to_string(), correct, seeds as usize));
+    }
+    LeftRightReport {
+        prompts: rows,
+        rate: good as f64 / total.max(1) as f64,
+    }
+}
+
+/// Result of the edit-locality probe.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LocalityReport {
+    /// Mean displacement of the leg joints between the original and the edited motion, cm.
+    pub leg_change_cm: f64,
+    /// How much higher the left wrist rises after the edit than before, cm.
+    pub left_wrist_rise_gain_cm: f64,
+}
+
+/// Generates `base` (a walk), edits the left arm with `instruction`, and measures how much the
+/// legs moved (root-relative, so a changed path does not count) and what the arm did.
+pub fn edit_locality(
+    generator: &Generator,
+    base: &str,
+    instruction: &str,
+    seed: u64,
+) -> LocalityReport {
+    let condition = generator.condition(base);
+    let options = SamplingOptions {
+        seed,
+        ..Default::default()
+    };
+    let original = generator.spam.generate(&condition, 120, &options);
+    let arm = generator.text.encode(&[instruction])[0];
+    let edited_text = part_text(
+        &generator.text.encode(&[base])[0],
+        &[(BodyPart::LeftArm, arm)],
+    );
+    let edited = generator.spam.edit_parts(
+        &original,
+        &edited_text,
+        &[BodyPart::LeftArm],
+        &SamplingOptions {
+            seed: seed + 1,
+            ..Default::default()
+        },
+    );
+    let (a, b) = (generator.joints(&original), generator.joints(&edited));
+    let legs = [
+        joint::L_HIP,
+        joint::R_HIP,
+        joint::L_KNEE,
+        joint::R_KNEE,
+        joint::L_ANKLE,
+        joint::R_ANKLE,
+        joint::L_FOOT,
+        joint::R_FOOT,
+    ];
+    let mut total = 0.0;
+    let mut count = 0;
+    for (p, q) in a.iter().zip(&b) {
+        for j in legs {
+            let rel_p = geom::sub(p[j], p[0]);
+            let rel_q = geom::sub(q[j], q[0]);
+            total += geom::dist(rel_p, rel_q);
+            count += 1;
+        }
+    }
+    LocalityReport {
+        leg_change_cm: total / count.max(1) as f64 * 100.0,
+        left_wrist_rise_gain_cm: (wrist_rise(&b, joint::L_WRIST) - wrist_rise(&a, joint::L_WRIST))
+            * 100.0,
+    }
+}
+
+/// Per frame, the root speed and the fastest joint speed (m/s).
+pub fn frame_speeds(poses: &[Pose]) -> Vec<(f64, f64)> {
+    poses
+        .windows(2)
+        .map(|w| {
+            let root = geom::dist(w[1][0], w[0][0]) * FPS;
+            let joint = w[1]
+                .iter()
+                .zip(&w[0])
+                .map(|(a, b)| geom::dist(*a, *b) * FPS)
+                .fold(0.0, f64::max);
+            (root, joint)
+        })
+        .collect()
+}
+
+/// The `q`-quantile (0–1) of values.
+pub fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    values[((values.len() - 1) as f64 * q).round() as usize]
+}
+
+/// Result of the continuity probe.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ContinuityReport {
+    /// Fastest root and joint speeds within ±2 frames of the join (m/s).
+    pub join_root_speed: f64,
+    pub join_joint_speed: f64,
+    /// 99th percentiles of those speeds over the reference motions (m/s).
+    pub p99_root_speed: f64,
+    pub p99_joint_speed: f64,
+}
+
+impl ContinuityReport {
+    /// True when the join is no faster than the 99th percentile of real motion.
+    pub fn passes(&self) -> bool {
+        self.join_root_speed <= self.p99_root_speed && self.join_joint_speed <= self.p99_joint_speed
+    }
+}
+
+/// Blends two generated segments and compares the speeds at the join with the 99th
+/// percentile of `reference` motions' frame-to-frame speeds.
+pub fn continuity(
+    generator: &Generator,
+    first: &str,
+    second: &str,
+    reference: &[Vec<Pose>],
+    seed: u64,
+) -> ContinuityReport {
+    let (ta, tb) = (generator.condition(first), generator.condition(second));
+    let a = generator.spam.generate(
+        &ta,
+        100,
+        &SamplingOptions {
+            seed,
+            ..Default::default()
+        },
+    );
+    let b = generator.spam.generate(
+        &tb,
+        100,
+        &SamplingOptions {
+            seed: seed + 1,
+            ..Default::default()
+        },
+    );
+    let joined = generator.spam.blend(
+        &a,
+        &b,
+        &ta,
+        &tb,
+        2,
+        &SamplingOptions {
+            seed: seed + 2,
+            ..Default::default()
+        },
+    );
+    let poses = generator.joints(&joined);
+    let join = a[0][0].len() * crate::model::vq::DOWNSAMPLE;
+    let speeds = frame_speeds(&poses);
+    let near = &speeds[join.saturating_sub(2).min(speeds.len())..(join + 2).min(speeds.len())];
+    let all: Vec<(f64, f64)> = reference.iter().flat_map(|m| frame_speeds(m)).collect();
+    ContinuityReport {
+        join_root_speed: near.iter().map(|s| s.0).fold(0.0, f64::max),
+        join_joint_speed: near.iter().map(|s| s.1).fold(0.0, f64::max),
+        p99_root_speed: quantile(all.iter().map(|s| s.0).collect(), 0.99),
+        p99_joint_speed: quantile(all.iter().map(|s| s.1).collect(), 0.99),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_and_speeds() {
+        assert_eq!(quantile(vec![3.0, 1.0, 2.0], 0.0), 1.0);
+        assert_eq!(quantile(vec![3.0, 1.0, 2.0], 1.0), 3.0);
+        assert!(quantile(vec![], 0.5).is_nan());
+        let a = [[0.0; 3]; 22];
+        let mut b = a;
+        b[0] = [0.05, 0.0, 0.0];
+        b[20] = [0.0, 0.1, 0.0];
+        let s = frame_speeds(&[a, b]);
+        assert!((s[0].0 - 1.0).abs() < 1e-9 && (s[0].1 - 2.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn wrist_rise_is_relative_to_the_start() {
+        let mut poses = vec![[[0.0; 3]; 22]; 3];
+        poses[0][joint::L_WRIST][1] = 1.0;
+        poses[1][joint::L_WRIST][1] = 1.6;
+        poses[2][joint::L_WRIST][1] = 1.2;
+        assert!((wrist_rise(&poses, joint::L_WRIST) - 0.6).abs() < 1e-12);
+    }
+}
