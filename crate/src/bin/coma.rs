@@ -206,6 +206,9 @@ enum TrainCommand {
         /// Override the total number of steps.
         #[arg(long)]
         steps: Option<usize>,
+        /// Training backend: flex (pure Rust) or tch (libtorch; needs the `tch` feature).
+        #[arg(long, default_value = "flex")]
+        device: String,
     },
     /// The base transformer (layer-0 tokens from text).
     Base(TransformerArgs),
@@ -240,6 +243,9 @@ struct TransformerArgs {
     /// Override the total number of steps.
     #[arg(long)]
     steps: Option<usize>,
+    /// Training backend: flex (pure Rust) or tch (libtorch; needs the `tch` feature).
+    #[arg(long, default_value = "flex")]
+    device: String,
 }
 
 #[derive(Subcommand)]
@@ -564,6 +570,7 @@ fn run(cli: Cli) -> Result<()> {
                     config,
                     minutes,
                     steps,
+                    device,
                 },
         } => {
             use burn::config::Config;
@@ -581,7 +588,7 @@ fn run(cli: Cli) -> Result<()> {
             if let Some(s) = steps {
                 cfg.steps = s;
             }
-            let device = burn::tensor::Device::flex().autodiff();
+            let device = coma::train::training_device(&device)?;
             let options = VqTrainOptions {
                 data,
                 run_dir: run,

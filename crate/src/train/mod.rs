@@ -6,3 +6,19 @@ pub mod run;
 pub mod tokens;
 pub mod transformer;
 pub mod vq;
+
+/// The autodiff device that training runs on: `flex` (pure Rust, always available) or `tch`
+/// (libtorch, about twice as fast on a CPU; only in builds with the `tch` feature).
+pub fn training_device(name: &str) -> anyhow::Result<burn::tensor::Device> {
+    match name {
+        "flex" => Ok(burn::tensor::Device::flex().autodiff()),
+        #[cfg(feature = "tch")]
+        // burn marks its libtorch device deprecated in favour of CubeCL backends, which cannot
+        // build on this machine; libtorch is still the fastest CPU trainer here.
+        #[allow(deprecated)]
+        "tch" => Ok(burn::tensor::Device::libtorch().autodiff()),
+        #[cfg(not(feature = "tch"))]
+        "tch" => anyhow::bail!("this build has no libtorch backend: build with `--features tch` (see crate/Cargo.toml)"),
+        other => anyhow::bail!("unknown device '{other}' (flex or tch)"),
+    }
+}
