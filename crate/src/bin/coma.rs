@@ -126,6 +126,23 @@ enum Command {
         #[arg(long, default_value = "static/models")]
         out: PathBuf,
     },
+    /// Reconstruction error of VQ-VAE weights on a split (mean per-joint position error).
+    VqError {
+        /// Weights: a run's vq.bpk or checkpoint/model.bpk.
+        #[arg(long, default_value = "static/models/vq.bpk")]
+        weights: PathBuf,
+        /// The run's training configuration (for the sizes).
+        #[arg(long, default_value = "configs/vq.json")]
+        config: PathBuf,
+        #[arg(long, default_value = "data/bandai")]
+        data: PathBuf,
+        /// train, val or test.
+        #[arg(long, default_value = "test")]
+        split: String,
+        /// At most this many motions.
+        #[arg(long, default_value_t = 100000)]
+        limit: usize,
+    },
     /// Control probes of the model.
     Probe {
         #[command(subcommand)]
@@ -740,6 +757,36 @@ fn run(cli: Cli) -> Result<()> {
             let device = burn::tensor::Device::flex();
             coma::model::Spam::load(&out, &device)?;
             println!("exported SPAM into {}", out.display());
+        }
+        Command::VqError {
+            weights,
+            config,
+            data,
+            split,
+            limit,
+        } => {
+            use burn::config::Config;
+            use burn::module::Module;
+            let split = match split.as_str() {
+                "train" => coma::dataset::Split::Train,
+                "val" => coma::dataset::Split::Val,
+                "test" => coma::dataset::Split::Test,
+                other => bail!("unknown split '{other}' (train, val or test)"),
+            };
+            let cfg = coma::train::vq::VqTrainingConfig::load(&config)
+                .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", config.display()))?;
+            let device = burn::tensor::Device::flex();
+            let model = cfg
+                .model
+                .init(&device)
+                .try_load_file(&weights)
+                .map_err(|e| anyhow::anyhow!("cannot load {}: {e:?}", weights.display()))?;
+            let set = coma::train::motions::MotionSet::load(&data, split)?;
+            let e = coma::train::vq::reconstruction_errors(&model, &set, &device, limit)?;
+            println!(
+                "{} motions of the {:?} split: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned)",
+                e.motions, split, e.global_mm, e.root_aligned_mm
+            );
         }
         Command::Text {
             command: TextCommand::Convert { from, out },
