@@ -181,26 +181,7 @@ impl Spam {
 
     /// Tokens of normalised features (cut to a multiple of 4 frames).
     pub fn tokenize(&self, features: &[FeatureFrame]) -> MotionTokens {
-        let t = (features.len() / DOWNSAMPLE * DOWNSAMPLE).max(DOWNSAMPLE);
-        let mut flat: Vec<f32> = features.iter().take(t).flatten().copied().collect();
-        flat.resize(t * FEATURE_DIM, 0.0);
-        let x = Tensor::<3>::from_data(TensorData::new(flat, [1, t, FEATURE_DIM]), &self.device);
-        self.vq
-            .tokenize(x)
-            .into_iter()
-            .map(|layers| {
-                layers
-                    .into_iter()
-                    .map(|l| {
-                        l.try_into_vec_as::<i64>()
-                            .expect("int tokens")
-                            .into_iter()
-                            .map(|v| v as u32)
-                            .collect()
-                    })
-                    .collect()
-            })
-            .collect()
+        self.vq.tokenize_motion(features, &self.device)
     }
 
     /// Normalised features of tokens (`4 × steps` frames).

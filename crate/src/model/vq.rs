@@ -475,6 +475,34 @@ impl MotionVq {
             .collect()
     }
 
+    /// Tokens `[part][layer][step]` of one normalised motion, cut to a multiple of 4 frames
+    /// (a motion shorter than 4 frames is padded with zeros, the mean pose).
+    pub fn tokenize_motion(
+        &self,
+        features: &[crate::features::FeatureFrame],
+        device: &Device,
+    ) -> Vec<Vec<Vec<u32>>> {
+        let t = (features.len() / DOWNSAMPLE * DOWNSAMPLE).max(DOWNSAMPLE);
+        let mut flat: Vec<f32> = features.iter().take(t).flatten().copied().collect();
+        flat.resize(t * FEATURE_DIM, 0.0);
+        let x = Tensor::<3>::from_data(TensorData::new(flat, [1, t, FEATURE_DIM]), device);
+        self.tokenize(x)
+            .into_iter()
+            .map(|layers| {
+                layers
+                    .into_iter()
+                    .map(|l| {
+                        l.try_into_vec_as::<i64>()
+                            .expect("int tokens")
+                            .into_iter()
+                            .map(|v| v as u32)
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Features `[B, 4N, 263]` from tokens (each part may use its first few layers only).
     pub fn decode(&self, tokens: &PartTokens) -> Tensor<3> {
         let parts: Vec<Tensor<3>> = tokens

@@ -29,6 +29,10 @@ pub struct Run {
     pub state: RunState,
     started: Instant,
     seconds_at_start: f64,
+    step_at_start: usize,
+    samples_at_start: u64,
+    /// Values recorded since the last progress line.
+    recent: Vec<Vec<f64>>,
     last_checkpoint: Instant,
     log: std::fs::File,
     columns: Vec<String>,
@@ -75,13 +79,17 @@ impl Run {
         if new_log {
             writeln!(log, "step,seconds,{}", columns.join(","))?;
         }
-        let seconds_at_start = state.seconds;
+        let (seconds_at_start, step_at_start, samples_at_start) =
+            (state.seconds, state.step, state.samples);
         Ok((
             Run {
                 dir: dir.to_path_buf(),
                 state,
                 started: Instant::now(),
                 seconds_at_start,
+                step_at_start,
+                samples_at_start,
+                recent: Vec::new(),
                 last_checkpoint: Instant::now(),
                 log,
                 columns: columns.iter().map(|c| c.to_string()).collect(),
@@ -111,27 +119,30 @@ impl Run {
         Ok(())
     }
 
-    /// Samples per second in this session.
-    pub fn samples_per_second(&self, samples_at_start: u64) -> f64 {
-        (self.state.samples - samples_at_start) as f64
-            / self.started.elapsed().as_secs_f64().max(1e-9)
+    /// Minutes this session has trained.
+    pub fn session_minutes(&self) -> f64 {
+        self.started.elapsed().as_secs_f64() / 60.0
     }
 
-    /// A progress line: step, epoch, the latest values, throughput and time left.
-    pub fn progress_line(
-        &self,
-        total_steps: usize,
-        epoch: f64,
-        values: &[f64],
-        samples_per_second: f64,
-        seconds_per_step: f64,
-    ) -> String {
+    /// A progress line: step, epoch, each column averaged over the steps since the last line,
+    /// this session's throughput and the time left.
+    pub fn progress_line(&mut self, total_steps: usize, epoch: f64) -> String {
+        let n = self.recent.len().max(1) as f64;
         let named: Vec<String> = self
             .columns
             .iter()
-            .zip(values)
-            .map(|(c, v)| format!("{c} {v:.4}"))
+            .enumerate()
+            .map(|(i, c)| {
+                format!(
+                    "{c} {:.4}",
+                    self.recent.iter().map(|r| r[i]).sum::<f64>() / n
+                )
+            })
             .collect();
+        self.recent.clear();
+        let seconds = self.started.elapsed().as_secs_f64().max(1e-9);
+        let samples_per_second = (self.state.samples - self.samples_at_start) as f64 / seconds;
+        let seconds_per_step = seconds / (self.state.step - self.step_at_start).max(1) as f64;
         let eta = (total_steps.saturating_sub(self.state.step)) as f64 * seconds_per_step;
         format!(
             "epoch {epoch:.2} step {}/{total_steps} {} | {samples_per_second:.1} samples/s | ETA {}",

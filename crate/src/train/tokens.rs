@@ -3,7 +3,7 @@
 
 use super::motions::MotionSet;
 use crate::model::transformer::{TransformerConfig, PARTS, TEXT_DIM};
-use crate::model::vq::{MotionVq, DOWNSAMPLE};
+use crate::model::vq::MotionVq;
 use crate::rng::Rng;
 use crate::skeleton::BodyPart;
 use anyhow::Result;
@@ -70,28 +70,7 @@ impl TokenSet {
         };
         let mut items = Vec::with_capacity(set.items.len());
         for (i, item) in set.items.iter().enumerate() {
-            let t = item.features.len() / DOWNSAMPLE * DOWNSAMPLE;
-            let flat: Vec<f32> = item.features[..t].iter().flatten().copied().collect();
-            let x = Tensor::<3>::from_data(
-                TensorData::new(flat, [1, t, crate::features::FEATURE_DIM]),
-                device,
-            );
-            let tokens = vq
-                .tokenize(x)
-                .into_iter()
-                .map(|layers| {
-                    layers
-                        .into_iter()
-                        .map(|l| {
-                            l.try_into_vec_as::<i64>()
-                                .expect("int tokens")
-                                .into_iter()
-                                .map(|v| v as u32)
-                                .collect()
-                        })
-                        .collect()
-                })
-                .collect();
+            let tokens = vq.tokenize_motion(&item.features, device);
             let captions = item.captions.iter().map(|c| intern(c)).collect();
             let parts =
                 std::array::from_fn(|p| item.parts.get(&BodyPart::ALL[p]).map(|s| intern(s)));

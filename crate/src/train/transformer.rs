@@ -14,7 +14,6 @@ use burn::prelude::*;
 use burn::tensor::activation::log_softmax;
 use burn::tensor::{Int, TensorData};
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// Which transformer a run trains.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -212,9 +211,6 @@ pub fn train_transformer(
         ));
     }
     let epoch_steps = (data.items.len() as f64 / config.batch_size as f64).max(1.0);
-    let (samples_at_start, steps_at_start) = (run.state.samples, run.state.step);
-    let session = Instant::now();
-    let mut recent: Vec<[f64; 2]> = Vec::new();
     while run.state.step < config.steps {
         let step = run.state.step;
         let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
@@ -252,29 +248,12 @@ pub fn train_transformer(
         let grads = GradientsParams::from_grads(loss.backward(), &model);
         model = optim.step(lr, model, grads);
         run.record(config.batch_size, &[loss_value, accuracy])?;
-        recent.push([loss_value, accuracy]);
 
         let done = run.state.step;
         if done % config.log_every == 0 || done == config.steps {
-            let n = recent.len() as f64;
-            let mean: Vec<f64> = (0..2)
-                .map(|i| recent.iter().map(|r| r[i]).sum::<f64>() / n)
-                .collect();
-            recent.clear();
-            let seconds_per_step =
-                session.elapsed().as_secs_f64() / (done - steps_at_start).max(1) as f64;
-            let line = run.progress_line(
-                config.steps,
-                done as f64 / epoch_steps,
-                &mean,
-                run.samples_per_second(samples_at_start),
-                seconds_per_step,
-            );
-            progress(&line);
+            progress(&run.progress_line(config.steps, done as f64 / epoch_steps));
         }
-        let out_of_time = options
-            .minutes
-            .is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
+        let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
         if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
             run.checkpoint(|dir| {
                 model

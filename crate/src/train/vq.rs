@@ -17,7 +17,6 @@ use burn::optim::{AdamWConfig, GradientsParams};
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// Everything a VQ training run is configured by (saved as the run's `config.json`).
 #[derive(Config, Debug)]
@@ -136,10 +135,6 @@ pub fn train_vq(
     let smooth_l1 = SmoothL1LossConfig::new().init();
     let epoch_steps =
         (train.frames() as f64 / (config.batch_size * config.max_frames) as f64).max(1.0);
-    let samples_at_start = run.state.samples;
-    let steps_at_start = run.state.step;
-    let session = Instant::now();
-    let mut recent = Vec::new();
     while run.state.step < config.steps {
         let step = run.state.step;
         // Each step's randomness depends only on the seed and the step, so a resumed run
@@ -176,25 +171,10 @@ pub fn train_vq(
         let reset = model.update_codebooks(&out.assignments, config.model.ema_decay, &mut rng);
         let logged = [values[0], values[1], values[2], reset as f64];
         run.record(crops.batch, &logged)?;
-        recent.push(logged);
 
         let done = run.state.step;
         if done % config.log_every == 0 || done == config.steps {
-            let n = recent.len() as f64;
-            let mean: Vec<f64> = (0..4)
-                .map(|i| recent.iter().map(|r| r[i]).sum::<f64>() / n)
-                .collect();
-            recent.clear();
-            let seconds_per_step =
-                session.elapsed().as_secs_f64() / (done - steps_at_start).max(1) as f64;
-            let line = run.progress_line(
-                config.steps,
-                done as f64 / epoch_steps,
-                &mean,
-                run.samples_per_second(samples_at_start),
-                seconds_per_step,
-            );
-            progress(&line);
+            progress(&run.progress_line(config.steps, done as f64 / epoch_steps));
         }
         let eval_due = done % config.eval_every == 0 || done == config.steps;
         if let Some(val) = val.as_ref().filter(|_| eval_due) {
@@ -206,9 +186,7 @@ pub fn train_vq(
             ));
             append_eval(&options.run_dir, done, &e)?;
         }
-        let out_of_time = options
-            .minutes
-            .is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
+        let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
         if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
             save_checkpoint(&mut run, &model, &optim)?;
             run.plot("VQ-VAE training", 20)?;
