@@ -589,14 +589,21 @@ mod tests {
         let mut vq = config.init(&device);
         let mut optim = burn::optim::AdamConfig::new().init();
         let mut rng = Rng::new(1);
-        let x = motion(4, 16, &device);
+        // Smooth signals, like motion features, rather than white noise.
+        let values: Vec<f32> = (0..4 * 16 * FEATURE_DIM)
+            .map(|i| {
+                let (b, t, c) = (i / (16 * FEATURE_DIM), (i / FEATURE_DIM) % 16, i % FEATURE_DIM);
+                (t as f32 * 0.3 + c as f32 * 0.7 + b as f32).sin()
+            })
+            .collect();
+        let x = Tensor::<3>::from_data(TensorData::new(values, [4, 16, FEATURE_DIM]), &device);
         let before = vq.quantizers[0]
             .codebooks
             .val()
             .try_into_vec_as::<f32>()
             .unwrap();
         let mut losses: Vec<f32> = Vec::new();
-        for _ in 0..30 {
+        for _ in 0..40 {
             let out = vq.forward_train(
                 x.clone(),
                 &config.clone().with_quantize_dropout(0.0),
@@ -605,10 +612,11 @@ mod tests {
             let loss = (out.reconstruction - x.clone()).abs().mean() + out.commitment * 0.02;
             losses.push(loss.clone().into_scalar::<f32>());
             let grads = burn::optim::GradientsParams::from_grads(loss.backward(), &vq);
-            vq = optim.step(1e-2, vq, grads);
+            vq = optim.step(3e-3, vq, grads);
             vq.update_codebooks(&out.assignments, config.ema_decay, &mut rng);
         }
-        assert!(losses[29] < losses[0] * 0.9, "{losses:?}");
+        let late = losses[35..].iter().sum::<f32>() / 5.0;
+        assert!(late < losses[0] * 0.8, "{losses:?}");
         let after = vq.quantizers[0]
             .codebooks
             .val()
