@@ -52,6 +52,21 @@ pub fn run_bench(
         }
     };
     rows.push(row("load SPAM weights", load * 1e3, "ms"));
+    rows.push(row(
+        "parameters: VQ-VAE (encoders, quantizers, decoder)",
+        spam.vq.num_params() as f64 / 1e6,
+        "M",
+    ));
+    rows.push(row(
+        "parameters: base transformer",
+        spam.base.num_params() as f64 / 1e6,
+        "M",
+    ));
+    rows.push(row(
+        "parameters: residual transformer",
+        spam.residual.num_params() as f64 / 1e6,
+        "M",
+    ));
     let (text, load_text) = seconds_of(|| SentenceEncoder::from_dir(models, &device));
     let text = text?;
     rows.push(row("load sentence encoder", load_text * 1e3, "ms"));

@@ -592,7 +592,11 @@ mod tests {
         // Smooth signals, like motion features, rather than white noise.
         let values: Vec<f32> = (0..4 * 16 * FEATURE_DIM)
             .map(|i| {
-                let (b, t, c) = (i / (16 * FEATURE_DIM), (i / FEATURE_DIM) % 16, i % FEATURE_DIM);
+                let (b, t, c) = (
+                    i / (16 * FEATURE_DIM),
+                    (i / FEATURE_DIM) % 16,
+                    i % FEATURE_DIM,
+                );
                 (t as f32 * 0.3 + c as f32 * 0.7 + b as f32).sin()
             })
             .collect();

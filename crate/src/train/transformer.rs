@@ -28,7 +28,7 @@ pub struct TransformerTrainingConfig {
     pub model: TransformerConfig,
     #[config(default = 64)]
     pub batch_size: usize,
-    #[config(default = 8000)]
+    #[config(default = 5000)]
     pub steps: usize,
     #[config(default = 2e-4)]
     pub learning_rate: f64,
