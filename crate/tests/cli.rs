@@ -146,3 +146,38 @@ fn bad_input_files_give_messages_not_panics() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("(T, 263)"));
 }
+
+#[test]
+fn generate_without_a_model_says_which_file_is_missing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = coma()
+        .args(["generate", "a person walks forward", "--models"])
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("spam.json") && !err.contains("panicked"),
+        "{err}"
+    );
+}
+
+#[test]
+fn edit_refuses_unknown_parts_and_missing_ranges() {
+    let out = coma()
+        .args([
+            "edit",
+            "x.npy",
+            "--text",
+            "wave",
+            "--out",
+            "y.npy",
+            "--models",
+            "/nonexistent",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+}
