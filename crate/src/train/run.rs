@@ -116,6 +116,7 @@ impl Run {
             self.state.seconds,
             cells.join(",")
         )?;
+        self.recent.push(values.to_vec());
         Ok(())
     }
 
@@ -135,7 +136,8 @@ impl Run {
             .map(|(i, c)| {
                 format!(
                     "{c} {:.4}",
-                    self.recent.iter().map(|r| r[i]).sum::<f64>() / n
+                    // A fold from +0 so an empty window prints 0 rather than −0.
+                    self.recent.iter().fold(0.0, |acc, r| acc + r[i]) / n
                 )
             })
             .collect();
@@ -256,6 +258,15 @@ mod tests {
         assert!(!resumed);
         run.record(8, &[1.5]).unwrap();
         run.record(8, &[1.0]).unwrap();
+        let line = run.progress_line(10, 0.5);
+        assert!(
+            line.contains("loss 1.2500") && line.contains("step 2/10"),
+            "{line}"
+        );
+        assert!(
+            run.progress_line(10, 0.5).contains("loss 0.0000"),
+            "the window restarts"
+        );
         run.checkpoint(|dir| Ok(std::fs::write(dir.join("model.bpk"), b"weights")?))
             .unwrap();
         run.record(8, &[0.5]).unwrap();
