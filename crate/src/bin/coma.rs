@@ -229,6 +229,14 @@ enum TrainCommand {
     },
     /// The base transformer (layer-0 tokens from text).
     Base(TransformerArgs),
+    /// Redraw a run's losses.png from its log.csv.
+    Plot {
+        /// Run folder.
+        run: PathBuf,
+        /// Steps averaged per plotted point.
+        #[arg(long, default_value_t = 20)]
+        smooth: usize,
+    },
     /// The residual transformer (layers 1.. from layer 0).
     Res(TransformerArgs),
 }
@@ -787,6 +795,20 @@ fn run(cli: Cli) -> Result<()> {
                 "{} motions of the {:?} split: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned)",
                 e.motions, split, e.global_mm, e.root_aligned_mm
             );
+        }
+        Command::Train {
+            command: TrainCommand::Plot { run, smooth },
+        } => {
+            let series = coma::train::run::read_log(&run.join("log.csv"), smooth)?;
+            let options = coma::render::plot::PlotOptions {
+                title: format!("training losses: {}", run.display()),
+                x_label: "step".into(),
+                y_label: "loss".into(),
+                log_y: true,
+                ..Default::default()
+            };
+            coma::render::plot::write_line_plot(&run.join("losses.png"), &series, &options)?;
+            println!("wrote {}", run.join("losses.png").display());
         }
         Command::Text {
             command: TextCommand::Convert { from, out },
