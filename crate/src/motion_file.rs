@@ -28,14 +28,18 @@ impl MotionData {
     }
 }
 
+/// The lower-cased file extension ("" when there is none).
+fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
 /// Reads `.npy` (shape (T, 263) features or (T, 22, 3) joints) or `.bvh` (our skeleton or
 /// Bandai-Namco's).
 pub fn read_motion(path: &Path) -> Result<MotionData> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
+    let ext = extension(path);
     match ext.as_str() {
         "npy" => {
             let array = NpyArray::read(path)?;
@@ -80,11 +84,7 @@ pub fn joints_to_json(poses: &[Pose]) -> serde_json::Value {
 /// Writes a motion as `.bvh`, `.json` (joints), or `.npy` (features when the motion has them
 /// or `as_features` asks for them, joints otherwise).
 pub fn write_motion(path: &Path, motion: &MotionData, as_features: bool) -> Result<()> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
+    let ext = extension(path);
     match ext.as_str() {
         "bvh" => std::fs::write(path, bvh::writer::write_bvh(&motion.joints(), FPS)?)?,
         "json" => std::fs::write(

@@ -183,6 +183,48 @@ impl Run {
         Ok(())
     }
 
+    /// The model and optimizer as the latest checkpoint left them.
+    pub fn restore<M: burn::module::Module>(
+        &self,
+        model: M,
+        optim: burn::optim::ModuleOptimizer,
+    ) -> Result<(M, burn::optim::ModuleOptimizer)> {
+        let model = model
+            .try_load_file(self.checkpoint_file("model.bpk"))
+            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's model: {e:?}"))?;
+        let optim = optim
+            .load(self.checkpoint_file("optim.bpk"))
+            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's optimizer: {e:?}"))?;
+        Ok((model, optim))
+    }
+
+    /// A line saying where a resumed run stands.
+    pub fn resumed_line(&self) -> String {
+        format!(
+            "resumed at step {} ({} trained)",
+            self.state.step,
+            format_duration(self.state.seconds)
+        )
+    }
+
+    /// Checkpoints the model and optimizer.
+    pub fn save<M: burn::module::Module>(
+        &mut self,
+        model: &M,
+        optim: &burn::optim::ModuleOptimizer,
+    ) -> Result<()> {
+        self.checkpoint(|dir| {
+            model
+                .clone()
+                .save_file(dir.join("model.bpk"))
+                .map_err(|e| anyhow::anyhow!("saving the model: {e:?}"))?;
+            optim
+                .save(dir.join("optim.bpk"))
+                .map_err(|e| anyhow::anyhow!("saving the optimizer: {e:?}"))?;
+            Ok(())
+        })
+    }
+
     /// Redraws `losses.png` from `log.csv`, one curve per column, averaged over windows of
     /// `smooth` steps so the trend is readable.
     pub fn plot(&self, title: &str, smooth: usize) -> Result<()> {

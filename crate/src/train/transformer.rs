@@ -2,7 +2,7 @@
 //! prediction with a cosine masking schedule (base) or next-layer prediction (residual), label
 //! smoothing, text dropout for classifier-free guidance, resumable checkpoints.
 
-use super::run::{format_duration, Run};
+use super::run::Run;
 use super::tokens::{TokenBatch, TokenSet};
 use crate::model::generate::mask_schedule;
 use crate::model::transformer::{BaseTransformer, ResidualTransformer, TransformerConfig, PARTS};
@@ -198,17 +198,8 @@ pub fn train_transformer(
         .with_grad_clipping(Some(GradientClippingConfig::Norm(1.0)))
         .init();
     if resumed {
-        model = model
-            .try_load_file(run.checkpoint_file("model.bpk"))
-            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's model: {e:?}"))?;
-        optim = optim
-            .load(run.checkpoint_file("optim.bpk"))
-            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's optimizer: {e:?}"))?;
-        progress(&format!(
-            "resumed at step {} ({} trained)",
-            run.state.step,
-            format_duration(run.state.seconds)
-        ));
+        (model, optim) = run.restore(model, optim)?;
+        progress(&run.resumed_line());
     }
     let epoch_steps = (data.items.len() as f64 / config.batch_size as f64).max(1.0);
     while run.state.step < config.steps {
@@ -255,16 +246,7 @@ pub fn train_transformer(
         }
         let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
         if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
-            run.checkpoint(|dir| {
-                model
-                    .clone()
-                    .save_file(dir.join("model.bpk"))
-                    .map_err(|e| anyhow::anyhow!("saving the model: {e:?}"))?;
-                optim
-                    .save(dir.join("optim.bpk"))
-                    .map_err(|e| anyhow::anyhow!("saving the optimizer: {e:?}"))?;
-                Ok(())
-            })?;
+            run.save(&model, &optim)?;
             run.plot(
                 if kind == Kind::Base {
                     "base transformer"

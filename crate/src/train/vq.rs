@@ -4,7 +4,7 @@
 //! on held-out motions.
 
 use super::motions::MotionSet;
-use super::run::{format_duration, Run};
+use super::run::Run;
 use crate::dataset::Split;
 use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM, POSITIONS};
 use crate::geom;
@@ -119,17 +119,8 @@ pub fn train_vq(
         .with_grad_clipping(Some(GradientClippingConfig::Norm(1.0)))
         .init();
     if resumed {
-        model = model
-            .try_load_file(run.checkpoint_file("model.bpk"))
-            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's model: {e:?}"))?;
-        optim = optim
-            .load(run.checkpoint_file("optim.bpk"))
-            .map_err(|e| anyhow::anyhow!("cannot load the checkpoint's optimizer: {e:?}"))?;
-        progress(&format!(
-            "resumed at step {} ({} trained)",
-            run.state.step,
-            format_duration(run.state.seconds)
-        ));
+        (model, optim) = run.restore(model, optim)?;
+        progress(&run.resumed_line());
     }
 
     let smooth_l1 = SmoothL1LossConfig::new().init();
@@ -188,7 +179,7 @@ pub fn train_vq(
         }
         let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
         if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
-            save_checkpoint(&mut run, &model, &optim)?;
+            run.save(&model, &optim)?;
             run.plot("VQ-VAE training", 20)?;
             progress(&format!("checkpoint at step {done}"));
         }
@@ -206,23 +197,6 @@ pub fn train_vq(
         progress(&format!("finished: weights in {}", weights.display()));
     }
     Ok(())
-}
-
-fn save_checkpoint(
-    run: &mut Run,
-    model: &MotionVq,
-    optim: &burn::optim::ModuleOptimizer,
-) -> Result<()> {
-    run.checkpoint(|dir| {
-        model
-            .clone()
-            .save_file(dir.join("model.bpk"))
-            .map_err(|e| anyhow::anyhow!("saving the model: {e:?}"))?;
-        optim
-            .save(dir.join("optim.bpk"))
-            .map_err(|e| anyhow::anyhow!("saving the optimizer: {e:?}"))?;
-        Ok(())
-    })
 }
 
 fn append_eval(dir: &Path, step: usize, e: &ReconstructionError) -> Result<()> {
