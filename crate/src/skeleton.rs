@@ -377,6 +377,15 @@ pub fn uniform_skeleton(poses: &[Pose], target: &Offsets) -> Vec<Pose> {
     forward_kinematics(&rotations, target, &root)
 }
 
+/// The largest distance (metres) between corresponding joints of two motions, over the frames
+/// both have.
+pub fn max_joint_distance(a: &[Pose], b: &[Pose]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| p.iter().zip(q).map(|(x, y)| geom::dist(*x, *y)))
+        .fold(0.0, f64::max)
+}
+
 /// Mirrors poses left/right: negates X and swaps left and right joints. Applying it twice
 /// gives back the input exactly.
 pub fn mirror_poses(poses: &[Pose]) -> Vec<Pose> {

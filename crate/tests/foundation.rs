@@ -141,11 +141,7 @@ fn mirroring_twice_is_the_identity_on_real_data() {
     // joints differ slightly: the reference skeleton's left and right bones differ in length.)
     let from_mirrored_features = features::features_to_joints(&features::mirror_features(&feats));
     let mirrored_joints = skeleton::mirror_poses(&features::features_to_joints(&feats));
-    let worst = from_mirrored_features
-        .iter()
-        .zip(&mirrored_joints)
-        .flat_map(|(a, b)| a.iter().zip(b).map(|(p, q)| geom::dist(*p, *q)))
-        .fold(0.0, f64::max);
+    let worst = skeleton::max_joint_distance(&from_mirrored_features, &mirrored_joints);
     assert!(worst < 1e-5, "largest joint difference {worst} m");
 }
 
@@ -182,10 +178,6 @@ fn bvh_written_and_read_back_gives_the_same_joints_within_a_millimetre() {
     let text = bvh::writer::write_bvh(&poses, features::FPS).unwrap();
     let back = bvh::to_smpl_motion(&Bvh::parse(&text).unwrap()).unwrap();
     assert_eq!(back.len(), poses.len());
-    let worst = poses
-        .iter()
-        .zip(&back)
-        .flat_map(|(a, b)| a.iter().zip(b).map(|(p, q)| geom::dist(*p, *q)))
-        .fold(0.0, f64::max);
+    let worst = skeleton::max_joint_distance(&poses, &back);
     assert!(worst < 1e-3, "worst joint error {:.2} mm", worst * 1e3);
 }

@@ -245,11 +245,7 @@ mod tests {
         let text = write_bvh(&poses, 20.0).unwrap();
         let back = to_smpl_motion(&Bvh::parse(&text).unwrap()).unwrap();
         assert_eq!(back.len(), poses.len());
-        let worst = poses
-            .iter()
-            .zip(&back)
-            .flat_map(|(a, b)| a.iter().zip(b).map(|(p, q)| geom::dist(*p, *q)))
-            .fold(0.0, f64::max);
+        let worst = crate::skeleton::max_joint_distance(&poses, &back);
         assert!(worst < 1e-4, "worst joint error {worst} m");
     }
 
