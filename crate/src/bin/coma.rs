@@ -111,6 +111,12 @@ enum Command {
     },
     /// Assemble trained runs into a model folder (the default model lives in static/models).
     Export {
+        /// What to export: the three SPAM networks, or the evaluator.
+        #[arg(value_enum, default_value_t = ExportWhat::Spam)]
+        what: ExportWhat,
+        /// Evaluator run folder (with evaluator.bpk and config.json).
+        #[arg(long, default_value = "runs/evaluator")]
+        evaluator: PathBuf,
         /// VQ-VAE run folder (with vq.bpk and config.json).
         #[arg(long, default_value = "runs/vq")]
         vq: PathBuf,
@@ -142,6 +148,47 @@ enum Command {
         /// At most this many motions.
         #[arg(long, default_value_t = 100000)]
         limit: usize,
+    },
+    /// The field's metrics on the test split (real motions, a retrieval baseline, SPAM) and
+    /// the control probes; writes EVAL.md and eval.json.
+    Eval {
+        /// Folder with evaluator.json and evaluator.bpk.
+        #[arg(long, default_value = "static/models")]
+        evaluator: PathBuf,
+        #[arg(long, default_value = "data/bandai")]
+        data: PathBuf,
+        /// Repetitions (each with fresh captions and seeds).
+        #[arg(long, default_value_t = 10)]
+        repeats: usize,
+        /// Test motions per repetition (whole batches of 32).
+        #[arg(long, default_value_t = 1024)]
+        motions: usize,
+        /// Captions × samples for SPAM's multimodality.
+        #[arg(long, default_value_t = 32)]
+        multimodality_texts: usize,
+        #[arg(long, default_value_t = 10)]
+        multimodality_samples: usize,
+        /// Seeds per prompt of the left/right probe.
+        #[arg(long, default_value_t = 20)]
+        probe_seeds: u64,
+        /// Leave SPAM out (real and retrieval rows only).
+        #[arg(long)]
+        no_spam: bool,
+        #[arg(long, default_value = "EVAL.md")]
+        markdown: PathBuf,
+        #[arg(long, default_value = "eval.json")]
+        json: PathBuf,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// How well a motion fits a text: the evaluator's similarity on a 0–100 scale.
+    Align {
+        text: String,
+        /// Motion file (.npy features or joints, or .bvh).
+        motion: PathBuf,
+        /// Folder with evaluator.json, evaluator.bpk, the sentence encoder and mean/std.npy.
+        #[arg(long, default_value = "static/models")]
+        models: PathBuf,
     },
     /// Control probes of the model.
     Probe {
@@ -239,6 +286,30 @@ enum TrainCommand {
     },
     /// The residual transformer (layers 1.. from layer 0).
     Res(TransformerArgs),
+    /// The text–motion evaluator (contrastive; measures motions, never generates).
+    Evaluator {
+        /// Dataset folder (from `coma data build`).
+        #[arg(long, default_value = "data/bandai")]
+        data: PathBuf,
+        /// Folder with the converted sentence encoder (minilm-*).
+        #[arg(long, default_value = "static/models")]
+        text_model: PathBuf,
+        #[arg(long, default_value = "runs/evaluator")]
+        run: PathBuf,
+        /// Training configuration (JSON); default: the run's config.json when resuming,
+        /// otherwise configs/evaluator.json.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Stop (with a checkpoint) after this many minutes.
+        #[arg(long)]
+        minutes: Option<f64>,
+        /// Override the total number of steps.
+        #[arg(long)]
+        steps: Option<usize>,
+        /// Training backend: flex (pure Rust) or tch (libtorch; needs the `tch` feature).
+        #[arg(long, default_value = "flex")]
+        device: String,
+    },
 }
 
 #[derive(clap::Args)]
@@ -320,6 +391,12 @@ enum TextCommand {
         #[arg(long, default_value = "static/models")]
         out: PathBuf,
     },
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ExportWhat {
+    Spam,
+    Evaluator,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -505,9 +582,123 @@ fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs
         &cfg,
         &tokens,
         &options,
-        &plain.autodiff(),
+        &coma::train::training_device(&args.device)?,
         &|l| println!("{l}"),
     )
+}
+
+/// `coma eval`: the protocol's rows and the probes, written to EVAL.md and eval.json.
+fn evaluate(
+    evaluator_dir: &std::path::Path,
+    data: &std::path::Path,
+    spam_dir: Option<&std::path::Path>,
+    options: &coma::eval::protocol::ProtocolOptions,
+    probe_seeds: u64,
+    markdown: &std::path::Path,
+    json: &std::path::Path,
+) -> Result<()> {
+    use coma::eval::protocol::{Protocol, Source};
+    use coma::eval::report::{EvalReport, JoinSpeeds, Probes};
+    let started = std::time::Instant::now();
+    let device = burn::tensor::Device::flex();
+    let (evaluator, config) = coma::eval::evaluator::Evaluator::load(evaluator_dir, &device)?;
+    let evaluator_id =
+        coma::model::model_id_of_dir(evaluator_dir, &["evaluator.json", "evaluator.bpk"])?;
+    let text = coma::text::minilm::SentenceEncoder::from_dir(evaluator_dir, &device)?;
+    let test = coma::train::motions::MotionSet::load(data, coma::dataset::Split::Test)?;
+    let train = coma::train::motions::MotionSet::load(data, coma::dataset::Split::Train)?;
+    let mut distinct: Vec<&str> = test
+        .items
+        .iter()
+        .chain(&train.items)
+        .flat_map(|i| i.captions.iter().map(String::as_str))
+        .collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    let mut sentences = std::collections::HashMap::new();
+    for chunk in distinct.chunks(64) {
+        for (c, e) in chunk.iter().zip(text.encode(chunk)) {
+            sentences.insert(c.to_string(), e);
+        }
+    }
+    eprintln!("embedded {} distinct captions", sentences.len());
+    let spam = match spam_dir {
+        Some(dir) => Some((
+            load_model(dir)?,
+            coma::model::model_id_of_dir(dir, &coma::model::WEIGHT_FILES)?,
+        )),
+        None => None,
+    };
+    let mut sources = vec![("real", Source::Real), ("retrieval", Source::Retrieval)];
+    if let Some(((s, _, _), _)) = &spam {
+        sources.push(("spam", Source::Spam(s)));
+    }
+    let protocol = Protocol {
+        evaluator: &evaluator,
+        config: &config,
+        device: &device,
+        test: &test,
+        train: &train,
+        sentences: &sentences,
+    };
+    let rows = protocol.run(&sources, options, &|l| eprintln!("{l}"))?;
+    let mut probes = Probes::default();
+    if let Some(((s, normalizer, text), _)) = &spam {
+        use coma::eval::probes::{continuity, edit_locality, left_right, Generator};
+        let generator = Generator {
+            spam: s,
+            text,
+            normalizer,
+        };
+        eprintln!("probes: left/right over {probe_seeds} seeds a prompt");
+        let lr = left_right(&generator, probe_seeds, 4.0);
+        probes.left_right_rate = Some(lr.rate);
+        probes.left_right = lr.prompts;
+        let locality = edit_locality(
+            &generator,
+            "a person walks forward",
+            "the person waves the left hand above the head",
+            0,
+        );
+        probes.edit_leg_change_cm = Some(locality.leg_change_cm);
+        probes.edit_left_wrist_gain_cm = Some(locality.left_wrist_rise_gain_cm);
+        let reference: Vec<_> = test
+            .items
+            .iter()
+            .map(|i| coma::features::features_to_joints(&test.normalizer.denormalize(&i.features)))
+            .collect();
+        let join = continuity(
+            &generator,
+            "a person walks forward",
+            "a person bows",
+            &reference,
+            0,
+        );
+        probes.join_speeds = Some(JoinSpeeds {
+            root: join.join_root_speed,
+            joint: join.join_joint_speed,
+            p99_root: join.p99_root_speed,
+            p99_joint: join.p99_joint_speed,
+        });
+    }
+    let command = std::env::args()
+        .skip(1)
+        .fold("coma".to_string(), |acc, a| acc + " " + &a);
+    let report = EvalReport {
+        command,
+        evaluator_id,
+        spam_id: spam.as_ref().map(|(_, id)| id.clone()),
+        test_motions: test.items.iter().filter(|i| !i.captions.is_empty()).count(),
+        options: options.clone(),
+        rows,
+        probes,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    std::fs::write(markdown, report.markdown())
+        .with_context(|| format!("writing {}", markdown.display()))?;
+    std::fs::write(json, report.json()).with_context(|| format!("writing {}", json.display()))?;
+    print!("{}", report.markdown());
+    Ok(())
 }
 
 fn main() {
@@ -625,6 +816,63 @@ fn run(cli: Cli) -> Result<()> {
             command: TrainCommand::Base(args),
         } => train_transformer(coma::train::transformer::Kind::Base, args)?,
         Command::Train {
+            command:
+                TrainCommand::Evaluator {
+                    data,
+                    text_model,
+                    run,
+                    config,
+                    minutes,
+                    steps,
+                    device,
+                },
+        } => {
+            use burn::config::Config;
+            use coma::train::evaluator::{
+                train_evaluator, CaptionedMotions, EvaluatorTrainOptions, EvaluatorTrainingConfig,
+            };
+            let path = config.unwrap_or_else(|| {
+                let own = run.join("config.json");
+                if own.exists() {
+                    own
+                } else {
+                    PathBuf::from("configs/evaluator.json")
+                }
+            });
+            let mut cfg = EvaluatorTrainingConfig::load(&path)
+                .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
+            if let Some(s) = steps {
+                cfg.steps = s;
+            }
+            let plain = burn::tensor::Device::flex();
+            let text = coma::text::minilm::SentenceEncoder::from_dir(&text_model, &plain)?;
+            let embed = |t: &[&str]| Ok(text.encode(t));
+            let load = |split| -> Result<CaptionedMotions> {
+                let set = coma::train::motions::MotionSet::load(&data, split)?;
+                CaptionedMotions::build(&set, &embed)
+            };
+            let train = load(coma::dataset::Split::Train)?;
+            let val = load(coma::dataset::Split::Val).ok();
+            println!(
+                "training on {} captioned motions ({} distinct captions), validating on {}",
+                train.motions.len(),
+                train.embeddings.len(),
+                val.as_ref().map_or(0, |v| v.motions.len())
+            );
+            let options = EvaluatorTrainOptions {
+                run_dir: run,
+                minutes,
+            };
+            train_evaluator(
+                &cfg,
+                &train,
+                val.as_ref(),
+                &options,
+                &coma::train::training_device(&device)?,
+                &|l| println!("{l}"),
+            )?;
+        }
+        Command::Train {
             command: TrainCommand::Res(args),
         } => train_transformer(coma::train::transformer::Kind::Residual, args)?,
         Command::Generate {
@@ -727,12 +975,88 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", coma::bench::table(&rows));
         }
         Command::Probe { command } => probe(command)?,
+        Command::Eval {
+            evaluator,
+            data,
+            repeats,
+            motions,
+            multimodality_texts,
+            multimodality_samples,
+            probe_seeds,
+            no_spam,
+            markdown,
+            json,
+            model,
+        } => {
+            let options = coma::eval::protocol::ProtocolOptions {
+                repeats,
+                motions,
+                multimodality_texts,
+                multimodality_samples,
+                ..Default::default()
+            };
+            let spam = (!no_spam).then_some(model.models.as_path());
+            evaluate(
+                &evaluator,
+                &data,
+                spam,
+                &options,
+                probe_seeds,
+                &markdown,
+                &json,
+            )?;
+        }
+        Command::Align {
+            text: prompt,
+            motion,
+            models,
+        } => {
+            let device = burn::tensor::Device::flex();
+            let (evaluator, config) = coma::eval::evaluator::Evaluator::load(&models, &device)?;
+            let text = coma::text::minilm::SentenceEncoder::from_dir(&models, &device)?;
+            let normalizer =
+                coma::features::Normalizer::read(models.join("mean.npy"), models.join("std.npy"))?;
+            let features = match read_motion(&motion)? {
+                coma::motion_file::MotionData::Features(f) => f,
+                coma::motion_file::MotionData::Joints(j) => {
+                    coma::features::joints_to_features(&j, &coma::skeleton::Offsets::reference())?.0
+                }
+            };
+            let m = evaluator.embed_motions(&config, &[&normalizer.normalize(&features)], &device);
+            let t = evaluator.embed_texts(&text.encode(&[prompt.as_str()]), &device);
+            println!(
+                "{:.1}",
+                coma::eval::evaluator::alignment_score(&t[0], &m[0])
+            );
+        }
+        Command::Export {
+            what: ExportWhat::Evaluator,
+            evaluator,
+            out,
+            ..
+        } => {
+            use burn::config::Config;
+            let cfg = coma::train::evaluator::EvaluatorTrainingConfig::load(
+                evaluator.join("config.json"),
+            )
+            .map_err(|e| anyhow::anyhow!("{}: {e}", evaluator.join("config.json").display()))?;
+            std::fs::create_dir_all(&out)?;
+            cfg.model
+                .save(out.join("evaluator.json"))
+                .map_err(|e| anyhow::anyhow!("writing evaluator.json: {e}"))?;
+            let from = evaluator.join("evaluator.bpk");
+            std::fs::copy(&from, out.join("evaluator.bpk"))
+                .with_context(|| format!("copying {}", from.display()))?;
+            coma::eval::evaluator::Evaluator::load(&out, &burn::tensor::Device::flex())?;
+            println!("exported the evaluator into {}", out.display());
+        }
         Command::Export {
             vq,
             base,
             res,
             data,
             out,
+            ..
         } => {
             use burn::config::Config;
             let load = |p: PathBuf| -> Result<serde_json::Value> {

@@ -189,6 +189,35 @@ pub fn frame_speeds(poses: &[Pose]) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Height above a motion's lowest foot position under which a foot counts as on the
+/// ground, metres.
+pub const CONTACT_HEIGHT: f64 = 0.05;
+/// Horizontal foot speed above which a grounded foot is skating, m/s (2.5 cm a frame).
+pub const SKATE_SPEED: f64 = 0.5;
+
+/// Foot skating: the fraction of frame pairs in which a foot (ankle or toe joint) stays within
+/// [`CONTACT_HEIGHT`] of the floor in both frames yet moves horizontally faster than
+/// [`SKATE_SPEED`]. The floor is the motion's lowest foot position.
+pub fn foot_skating(poses: &[Pose]) -> f64 {
+    let feet = [joint::L_ANKLE, joint::R_ANKLE, joint::L_FOOT, joint::R_FOOT];
+    let floor = poses
+        .iter()
+        .flat_map(|p| feet.iter().map(move |&f| p[f][1]))
+        .fold(f64::INFINITY, f64::min);
+    let mut skating = 0usize;
+    for w in poses.windows(2) {
+        let slides = feet.iter().any(|&f| {
+            let grounded =
+                w[0][f][1] - floor < CONTACT_HEIGHT && w[1][f][1] - floor < CONTACT_HEIGHT;
+            let dx = w[1][f][0] - w[0][f][0];
+            let dz = w[1][f][2] - w[0][f][2];
+            grounded && (dx * dx + dz * dz).sqrt() * FPS > SKATE_SPEED
+        });
+        skating += slides as usize;
+    }
+    skating as f64 / poses.len().saturating_sub(1).max(1) as f64
+}
+
 /// The `q`-quantile (0–1) of values.
 pub fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
     if values.is_empty() {
@@ -281,6 +310,31 @@ mod tests {
         b[20] = [0.0, 0.1, 0.0];
         let s = frame_speeds(&[a, b]);
         assert!((s[0].0 - 1.0).abs() < 1e-9 && (s[0].1 - 2.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_planted_foot_does_not_skate_and_a_sliding_one_does() {
+        let mut poses = vec![[[0.0; 3]; 22]; 11];
+        for (t, p) in poses.iter_mut().enumerate() {
+            for j in 0..22 {
+                p[j][1] = 0.5;
+            }
+            // Left foot planted, right foot lifted and swinging forward.
+            p[joint::L_ANKLE] = [0.1, 0.02, 0.0];
+            p[joint::L_FOOT] = [0.1, 0.0, 0.1];
+            p[joint::R_ANKLE] = [-0.1, 0.2, t as f64 * 0.05];
+            p[joint::R_FOOT] = [-0.1, 0.2, t as f64 * 0.05 + 0.1];
+        }
+        assert_eq!(foot_skating(&poses), 0.0);
+        // Now the planted foot slides 5 cm a frame (1 m/s) for half the motion.
+        for (t, p) in poses.iter_mut().enumerate().skip(5) {
+            p[joint::L_FOOT][2] = 0.1 + (t - 5) as f64 * 0.05;
+        }
+        assert!(
+            (foot_skating(&poses) - 0.5).abs() < 1e-12,
+            "{}",
+            foot_skating(&poses)
+        );
     }
 
     #[test]

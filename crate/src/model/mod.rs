@@ -52,6 +52,41 @@ pub struct SpamConfig {
     pub residual: TransformerConfig,
 }
 
+/// The weight files of a SPAM model folder, in the order its id hashes them.
+pub const WEIGHT_FILES: [&str; 6] = [
+    "spam.json",
+    "vq.bpk",
+    "base.bpk",
+    "residual.bpk",
+    "mean.npy",
+    "std.npy",
+];
+
+/// A model's id: the first 16 hex digits of the SHA-256 of its weight files, in
+/// [`WEIGHT_FILES`] order. Share links name the model they were made with by this id.
+pub fn model_id(files: &[&[u8]]) -> String {
+    use sha2::{Digest, Sha256};
+    let mut hash = Sha256::new();
+    for f in files {
+        hash.update((f.len() as u64).to_le_bytes());
+        hash.update(f);
+    }
+    hash.finalize()[..8]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// The id of the model in a folder (see [`model_id`]).
+pub fn model_id_of_dir(dir: &std::path::Path, files: &[&str]) -> std::io::Result<String> {
+    let bytes = files
+        .iter()
+        .map(|f| std::fs::read(dir.join(f)))
+        .collect::<std::io::Result<Vec<_>>>()?;
+    let refs: Vec<&[u8]> = bytes.iter().map(Vec::as_slice).collect();
+    Ok(model_id(&refs))
+}
+
 /// Why SPAM could not be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum SpamLoadError {

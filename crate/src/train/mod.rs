@@ -1,6 +1,7 @@
 //! Training: the data in memory, run bookkeeping (checkpoints, logs, plots) and the training
 //! loops of the motion model.
 
+pub mod evaluator;
 pub mod motions;
 pub mod run;
 pub mod tokens;

@@ -277,6 +277,22 @@ pub fn read_log(path: &Path, smooth: usize) -> Result<Vec<crate::render::plot::S
         .collect())
 }
 
+/// Appends a row to a CSV file, writing `header` first when the file is new (validation
+/// figures of a run, one row per evaluation).
+pub fn append_csv(path: &Path, header: &str, row: &str) -> Result<()> {
+    let fresh = !path.exists();
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("opening {}", path.display()))?;
+    if fresh {
+        writeln!(f, "{header}")?;
+    }
+    writeln!(f, "{row}")?;
+    Ok(())
+}
+
 /// `1h 02m` / `3m 20s` / `12s`.
 pub fn format_duration(seconds: f64) -> String {
     let s = seconds.max(0.0) as u64;

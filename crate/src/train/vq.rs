@@ -16,7 +16,7 @@ use burn::nn::loss::SmoothL1LossConfig;
 use burn::optim::{AdamWConfig, GradientsParams};
 use burn::prelude::*;
 use burn::tensor::TensorData;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Everything a VQ training run is configured by (saved as the run's `config.json`).
 #[derive(Config, Debug)]
@@ -175,7 +175,11 @@ pub fn train_vq(
                 "step {done}: validation reconstruction error {:.1} mm root-aligned MPJPE, {:.1} mm with the root path integrated",
                 e.root_aligned_mm, e.global_mm
             ));
-            append_eval(&options.run_dir, done, &e)?;
+            super::run::append_csv(
+                &options.run_dir.join("val.csv"),
+                "step,mpjpe_root_aligned_mm,error_root_integrated_mm",
+                &format!("{done},{:.3},{:.3}", e.root_aligned_mm, e.global_mm),
+            )?;
         }
         let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
         if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
@@ -196,21 +200,6 @@ pub fn train_vq(
             .map_err(|e| anyhow::anyhow!("saving {}: {e:?}", weights.display()))?;
         progress(&format!("finished: weights in {}", weights.display()));
     }
-    Ok(())
-}
-
-fn append_eval(dir: &Path, step: usize, e: &ReconstructionError) -> Result<()> {
-    use std::io::Write;
-    let path = dir.join("val.csv");
-    let fresh = !path.exists();
-    let mut f = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&path)?;
-    if fresh {
-        writeln!(f, "step,mpjpe_root_aligned_mm,error_root_integrated_mm")?;
-    }
-    writeln!(f, "{step},{:.3},{:.3}", e.root_aligned_mm, e.global_mm)?;
     Ok(())
 }
 

@@ -1,0 +1,142 @@
+//! The evaluation report: `EVAL.md` for people and `eval.json` for programs, with the command
+//! that made them and the ids of the weights measured.
+
+use super::protocol::{markdown_table, ProtocolOptions, Row};
+use std::collections::BTreeMap;
+
+/// Rows in the order the tables show them.
+pub const ROW_ORDER: [&str; 4] = ["real", "retrieval", "spam", "spam_review"];
+
+/// Control probes of the model (absent when no SPAM model was measured).
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Probes {
+    /// Share of raise/wave samples where the asked wrist ends higher than the other.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub left_right_rate: Option<f64>,
+    /// Per prompt: (prompt, correct, samples).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub left_right: Vec<(String, usize, usize)>,
+    /// Mean leg-joint displacement after a left-arm edit of a walk, cm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edit_leg_change_cm: Option<f64>,
+    /// How much higher the left wrist rises after that edit, cm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edit_left_wrist_gain_cm: Option<f64>,
+    /// Fastest root and joint speeds at a blend join, and the 99th percentiles of real
+    /// motion, m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub join_speeds: Option<JoinSpeeds>,
+}
+
+/// Speeds at a join against real motion.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct JoinSpeeds {
+    pub root: f64,
+    pub joint: f64,
+    pub p99_root: f64,
+    pub p99_joint: f64,
+}
+
+/// Everything `coma eval` measured.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EvalReport {
+    /// The command that produced the report.
+    pub command: String,
+    /// Id of the evaluator's weights and of the SPAM model (see `model::model_id`).
+    pub evaluator_id: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spam_id: Option<String>,
+    /// Captioned motions in the test split.
+    pub test_motions: usize,
+    pub options: ProtocolOptions,
+    pub rows: BTreeMap<String, Row>,
+    pub probes: Probes,
+    /// Wall-clock seconds the evaluation took.
+    pub seconds: f64,
+}
+
+fn describe(name: &str) -> &'static str {
+    match name {
+        "real" => "the test motions themselves",
+        "retrieval" => {
+            "the training motion whose caption is nearest (MiniLM cosine) to the test caption"
+        }
+        "spam" => "SPAM, one shot, a motion of the test motion's length from the caption",
+        "spam_review" => "SPAM with the review loop",
+        _ => "",
+    }
+}
+
+impl EvalReport {
+    /// `eval.json`: `{"rows": {...}, "probes": {...}, ...}`.
+    pub fn json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("the report serialises")
+    }
+
+    /// `EVAL.md`.
+    pub fn markdown(&self) -> String {
+        let o = &self.options;
+        let mut md = format!(
+            "# Evaluation\n\nMade by `{}` in {:.0} s. Evaluator `{}`{}.\n\n",
+            self.command,
+            self.seconds,
+            self.evaluator_id,
+            self.spam_id
+                .as_ref()
+                .map_or(String::new(), |id| format!(", SPAM model `{id}`"))
+        );
+        md.push_str(&format!(
+            "Protocol: the test split ({} captioned motions); per repetition {} motions, each with one of its captions drawn at random, R-precision in batches of 32, FID against all test motions, diversity over {} pairs, multimodality over {} captions × {} samples ({} pairs each); {} repetitions, mean ± 95 % interval. Embeddings are the evaluator's unit vectors, so distances lie in [0, 2].\n\n",
+            self.test_motions,
+            o.motions.min(self.test_motions) / super::protocol::BATCH * super::protocol::BATCH,
+            o.diversity_pairs,
+            o.multimodality_texts,
+            o.multimodality_samples,
+            o.multimodality_pairs,
+            o.repeats,
+        ));
+        md.push_str("## Text-to-motion metrics\n\n");
+        md.push_str(&markdown_table(&self.rows, &ROW_ORDER));
+        md.push('\n');
+        for name in ROW_ORDER.iter().filter(|n| self.rows.contains_key(**n)) {
+            md.push_str(&format!("- **{name}**: {}\n", describe(name)));
+        }
+        md.push_str("\n## Control probes\n\n| probe | figure |\n|---|---|\n");
+        let p = &self.probes;
+        if let Some(rate) = p.left_right_rate {
+            md.push_str(&format!(
+                "| left/right: asked wrist ends higher | {:.1} % |\n",
+                rate * 100.0
+            ));
+            for (prompt, good, total) in &p.left_right {
+                md.push_str(&format!("| &nbsp;&nbsp;\"{prompt}\" | {good}/{total} |\n"));
+            }
+        }
+        if let Some(cm) = p.edit_leg_change_cm {
+            md.push_str(&format!(
+                "| left-arm edit of a walk: mean leg-joint change | {cm:.2} cm |\n"
+            ));
+        }
+        if let Some(cm) = p.edit_left_wrist_gain_cm {
+            md.push_str(&format!(
+                "| left-arm edit of a walk: extra left-wrist rise | {cm:.1} cm |\n"
+            ));
+        }
+        if let Some(j) = p.join_speeds {
+            md.push_str(&format!(
+                "| blend join: root speed (real 99th percentile) | {:.2} m/s ({:.2}) |\n| blend join: fastest joint (real 99th percentile) | {:.2} m/s ({:.2}) |\n",
+                j.root, j.p99_root, j.joint, j.p99_joint
+            ));
+        }
+        for name in ROW_ORDER {
+            if let Some(row) = self.rows.get(name) {
+                md.push_str(&format!(
+                    "| foot skating ratio: {name} | {} |\n",
+                    row.foot_skating
+                ));
+            }
+        }
+        md.push_str("| trajectory error | not measured yet (needs the trajectory editor) |\n");
+        md
+    }
+}
