@@ -16,6 +16,7 @@ pub mod posecodes;
 pub mod render;
 pub mod rng;
 pub mod serve;
+pub mod share;
 pub mod skeleton;
 pub mod text;
 pub mod train;

@@ -1,0 +1,215 @@
+use super::*;
+use crate::rng::Rng;
+
+fn sample(steps: usize) -> SharedMotion {
+    let mut rng = Rng::new(11);
+    SharedMotion {
+        model_id: model_id_bytes("0123456789abcdef").unwrap(),
+        seed: 42,
+        prompt: "a person walks forward waving the left hand, then bows — «politely»".into(),
+        plan: r#"{"segments":[{"text":"walk forward","seconds":4.0}]}"#.into(),
+        history: vec![
+            Edit {
+                kind: EditKind::Generate,
+                text: "a person walks forward".into(),
+                from_frame: 0,
+                to_frame: 0,
+                parts: 0,
+                seed: 42,
+            },
+            Edit {
+                kind: EditKind::BodyParts,
+                text: "waves the left hand".into(),
+                from_frame: 0,
+                to_frame: 80,
+                parts: 0b0001,
+                seed: u64::MAX,
+            },
+        ],
+        tokens: (0..4)
+            .map(|_| {
+                (0..4)
+                    .map(|_| (0..steps).map(|_| rng.below(512) as u32).collect())
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
+#[test]
+fn a_motion_survives_the_round_trip_in_any_form_of_link() {
+    let motion = sample(49);
+    let fragment = encode(&motion);
+    assert!(fragment.starts_with("m="));
+    assert!(fragment
+        .bytes()
+        .all(|b| b.is_ascii_alphanumeric() || b"-_=".contains(&b)));
+    assert_eq!(decode(&fragment).unwrap(), motion);
+    assert_eq!(decode(&format!("#{fragment}")).unwrap(), motion);
+    let url = format!("http://127.0.0.1:8080/index.html#{fragment}");
+    assert_eq!(decode(&url).unwrap(), motion);
+    assert_eq!(decode(&format!("#x=1&{fragment}")).unwrap(), motion);
+}
+
+#[test]
+fn tokens_are_packed_in_nine_bits() {
+    let motion = sample(49);
+    // 4 parts × 4 layers × 49 steps × 9 bits.
+    let tokens_bytes = (4 * 4 * 49 * 9usize).div_ceil(8);
+    let p = payload(&motion);
+    assert!(p.len() < tokens_bytes + 300, "{} bytes", p.len());
+    // A 196-frame motion with its plan fits comfortably in a URL.
+    assert!(encode(&motion).len() < 2500, "{}", encode(&motion).len());
+}
+
+#[test]
+fn oversized_fields_are_cut_so_the_link_still_opens() {
+    let mut motion = sample(3);
+    motion.prompt = "é".repeat(MAX_TEXT);
+    motion.tokens[0][0][0] = 100_000;
+    let back = decode(&encode(&motion)).unwrap();
+    assert!(back.prompt.len() <= MAX_TEXT && back.prompt.chars().all(|c| c == 'é'));
+    assert_eq!(back.tokens[0][0][0], MAX_CODE);
+}
+
+#[test]
+fn broken_links_give_clear_errors() {
+    let good = encode(&sample(10));
+    let id = model_id_bytes("0123456789abcdef").unwrap();
+    let link = |payload: &[u8]| {
+        format!(
+            "m={}",
+            base64url::encode(&miniz_oxide::deflate::compress_to_vec(payload, 6))
+        )
+    };
+    let mut future = payload(&sample(10));
+    future[2] = 2;
+    let mut header = b"CM\x01".to_vec();
+    header.extend_from_slice(&id);
+    let cases: Vec<(String, LinkError)> = vec![
+        ("".into(), LinkError::NotALink),
+        ("#".into(), LinkError::NotALink),
+        ("http://127.0.0.1:8080/".into(), LinkError::NotALink),
+        ("#q=abc".into(), LinkError::NotALink),
+        (
+            "m=".into(),
+            LinkError::BadCompression("FailedCannotMakeProgress".into()),
+        ),
+        ("m=%%%".into(), LinkError::BadEncoding),
+        ("m=A".into(), LinkError::BadEncoding),
+        (
+            format!("m={}", "A".repeat(MAX_LINK_CHARS + 4)),
+            LinkError::TooLong,
+        ),
+        (link(b"XY\x01"), LinkError::BadMagic),
+        (link(b""), LinkError::BadMagic),
+        (link(&future), LinkError::UnknownVersion(2)),
+        (link(&header), LinkError::Truncated),
+        (
+            good[..good.len() / 2].to_string(),
+            LinkError::BadCompression("FailedCannotMakeProgress".into()),
+        ),
+    ];
+    for (input, expected) in cases {
+        let got = decode(&input);
+        match (&got, &expected) {
+            // The exact inflate status of a cut stream is the library's business.
+            (Err(LinkError::BadCompression(_)), LinkError::BadCompression(_)) => {}
+            (Err(LinkError::BadEncoding), LinkError::BadCompression(_)) => {}
+            _ => assert_eq!(got, Err(expected.clone()), "input {input:?}"),
+        }
+    }
+    // Every error reads as a sentence for the page.
+    assert!(LinkError::UnknownVersion(2)
+        .to_string()
+        .contains("newer version"));
+}
+
+#[test]
+fn payloads_with_impossible_fields_are_refused() {
+    let base = payload(&sample(5));
+    let parsed = |p: &[u8]| parse_payload(p);
+    assert!(parsed(&base).is_ok());
+    // Trailing garbage.
+    let mut extra = base.clone();
+    extra.push(0);
+    assert!(matches!(parsed(&extra), Err(LinkError::Invalid(_))));
+    // A prompt length of 2^62.
+    let mut huge = base[..11].to_vec();
+    huge.push(42);
+    huge.extend_from_slice(&[0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0x3f]);
+    assert!(matches!(parsed(&huge), Err(LinkError::Invalid(_))));
+    // A varint of more than 64 bits.
+    let mut long = base[..11].to_vec();
+    long.extend_from_slice(&[0xff; 11]);
+    assert!(matches!(parsed(&long), Err(LinkError::Invalid(_))));
+}
+
+/// Flips, inserts, deletes and overwrites bytes of `data`.
+fn mutate(data: &mut Vec<u8>, rng: &mut Rng) {
+    for _ in 0..1 + rng.below(4) {
+        let at = if data.is_empty() {
+            0
+        } else {
+            rng.below(data.len())
+        };
+        match rng.below(5) {
+            0 if !data.is_empty() => data[at] ^= 1 << rng.below(8),
+            1 => data.insert(at.min(data.len()), rng.below(256) as u8),
+            2 if !data.is_empty() => {
+                data.remove(at);
+            }
+            3 if !data.is_empty() => data[at] = [0, 0xff, 0x7f, 0x80, 1][rng.below(5)],
+            _ => data.truncate(at),
+        }
+    }
+}
+
+#[test]
+fn the_decoder_survives_a_million_random_and_mutated_links() {
+    let seeds: Vec<Vec<u8>> = [1usize, 10, 49, 196]
+        .iter()
+        .map(|&s| payload(&sample(s)))
+        .collect();
+    let fragments: Vec<String> = [1usize, 10, 49]
+        .iter()
+        .map(|&s| encode(&sample(s)))
+        .collect();
+    let mut rng = Rng::new(2024);
+    let mut outcomes = [0usize; 2];
+    let alphabet = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_=#&%";
+    for i in 0..1_000_000 {
+        let result = match i % 4 {
+            // Mutated payloads, compressed properly: they reach the parser.
+            0 | 1 => {
+                let mut p = seeds[rng.below(seeds.len())].clone();
+                mutate(&mut p, &mut rng);
+                decode(&format!(
+                    "m={}",
+                    base64url::encode(&miniz_oxide::deflate::compress_to_vec(&p, 1))
+                ))
+            }
+            // Mutated link text.
+            2 => {
+                let mut f = fragments[rng.below(fragments.len())].clone().into_bytes();
+                mutate(&mut f, &mut rng);
+                decode(&String::from_utf8_lossy(&f))
+            }
+            // Random text.
+            _ => {
+                let n = rng.below(64);
+                let text: String = std::iter::once("m=")
+                    .map(String::from)
+                    .chain(
+                        (0..n).map(|_| (alphabet[rng.below(alphabet.len())] as char).to_string()),
+                    )
+                    .collect();
+                decode(&text)
+            }
+        };
+        outcomes[result.is_ok() as usize] += 1;
+    }
+    // Most inputs are refused, and none panicked on the way.
+    assert_eq!(outcomes[0] + outcomes[1], 1_000_000);
+    assert!(outcomes[0] > 500_000, "{outcomes:?}");
+}
