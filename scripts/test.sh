@@ -19,3 +19,16 @@ cargo test --workspace --release
 
 echo "== the page builds"
 build_page
+
+echo "== the page in headless Chromium"
+ensure_browser_tools
+target_dir="${CARGO_TARGET_DIR:-target}"
+if [ ! -f dist/static/models/spam.json ]; then
+  # No trained SPAM is committed yet: the suite checks the page's plumbing with random
+  # weights of the default sizes (never shipped as the default model).
+  "$target_dir/release/coma" export random --data ../shared/data/humanml3d-reference --out dist/static/models
+fi
+coma_bin="$(realpath "$target_dir/release/coma")"
+shots="$(realpath -m "$target_dir/e2e-screenshots")"
+mkdir -p "$shots"
+(cd e2e && COMA="$coma_bin" DIST=../dist SHOTS="$shots" node --test --test-concurrency=1 page.test.mjs)

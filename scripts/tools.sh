@@ -13,6 +13,18 @@ ensure_rust_tools() {
   fi
 }
 
+# Debian's Chromium and its driver, and Playwright's driver library (no browser download):
+# what the browser tests need.
+ensure_browser_tools() {
+  if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
+    echo "installing chromium and chromium-driver (once)"
+    apt-get update -q && apt-get install -y -q chromium chromium-driver
+  fi
+  if [ ! -d e2e/node_modules/playwright-core ]; then
+    (cd e2e && npm install --no-audit --no-fund)
+  fi
+}
+
 # Builds the page into dist/: the wasm module, its JS glue, index.html and static/.
 build_page() {
   local target_dir="${CARGO_TARGET_DIR:-target}"

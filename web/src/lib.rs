@@ -1,24 +1,44 @@
-//! The page's wasm entry point. For now it only proves that the Rust → wasm → page path works:
-//! it replaces the loading message with a status line. The Leptos app replaces this.
+//! The page: a Leptos app (the UI, on the main thread) and an inference worker (the models,
+//! in a Web Worker), built from this one wasm module. [`start`] mounts the app in a window;
+//! [`worker_main`] is called by `static/worker.js` inside the worker.
+//!
+//! The modules without a browser in them (messages, history, takes, exports, the viewer's
+//! scene) build and test natively; the rest only for wasm32.
 
+pub mod exports;
+pub mod history;
+pub mod messages;
+pub mod take;
+pub mod viewer;
+
+#[cfg(target_arch = "wasm32")]
+mod app;
+#[cfg(target_arch = "wasm32")]
+mod browser;
+#[cfg(target_arch = "wasm32")]
+mod client;
+#[cfg(target_arch = "wasm32")]
+mod ui;
+#[cfg(target_arch = "wasm32")]
+mod worker;
+
+#[cfg(target_arch = "wasm32")]
 use wasm_bindgen::prelude::*;
 
-/// Called by the browser once the module is instantiated.
+/// Runs when the module is instantiated, in the page and in the worker alike: only a page
+/// (which has a window) mounts the app.
+#[cfg(target_arch = "wasm32")]
 #[wasm_bindgen(start)]
-pub fn start() -> Result<(), JsValue> {
-    let document = web_sys::window()
-        .and_then(|w| w.document())
-        .ok_or_else(|| JsValue::from_str("no document"))?;
-    if let Some(status) = document.get_element_by_id("status") {
-        status.set_text_content(Some(&status_text()));
+pub fn start() {
+    console_error_panic_hook::set_once();
+    if web_sys::window().is_some() {
+        leptos::mount::mount_to_body(app::App);
     }
-    Ok(())
 }
 
-/// The status line the page shows once the wasm module runs.
-pub fn status_text() -> String {
-    format!(
-        "CoMA {} loaded. The motion model and editor are not in the page yet.",
-        env!("CARGO_PKG_VERSION")
-    )
+/// The worker's entry point (see `static/worker.js`).
+#[cfg(target_arch = "wasm32")]
+#[wasm_bindgen]
+pub fn worker_main() {
+    worker::start();
 }

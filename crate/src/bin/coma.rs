@@ -395,8 +395,13 @@ enum TextCommand {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum ExportWhat {
+    /// The three trained SPAM networks.
     Spam,
+    /// The trained evaluator.
     Evaluator,
+    /// SPAM with random weights at the default sizes (configs/spam.json), for tests of the
+    /// plumbing before trained weights exist; never the default model.
+    Random,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -408,18 +413,13 @@ enum ViewArg {
 
 /// Runs a control probe and prints its figures.
 fn probe(command: ProbeCommand) -> Result<()> {
-    use coma::eval::probes::{continuity, edit_locality, left_right, Generator};
+    use coma::eval::probes::{continuity, edit_locality, left_right};
     let models = match &command {
         ProbeCommand::Leftright { model, .. }
         | ProbeCommand::Locality { model, .. }
         | ProbeCommand::Continuity { model, .. } => model.models.clone(),
     };
-    let (spam, normalizer, text) = load_model(&models)?;
-    let generator = Generator {
-        spam: &spam,
-        text: &text,
-        normalizer: &normalizer,
-    };
+    let generator = load_model(&models)?;
     match command {
         ProbeCommand::Leftright { seeds, .. } => {
             let report = left_right(&generator, seeds, 4.0);
@@ -473,32 +473,23 @@ fn probe(command: ProbeCommand) -> Result<()> {
     Ok(())
 }
 
-type Loaded = (
-    coma::model::Spam,
-    coma::features::Normalizer,
-    coma::text::minilm::SentenceEncoder,
-);
-
 /// SPAM and the sentence encoder from a model folder, on the CPU.
-fn load_model(dir: &std::path::Path) -> Result<Loaded> {
-    let device = burn::tensor::Device::flex();
-    let (spam, normalizer) = coma::model::Spam::load(dir, &device)?;
-    let text = coma::text::minilm::SentenceEncoder::from_dir(dir, &device)?;
-    Ok((spam, normalizer, text))
+fn load_model(dir: &std::path::Path) -> Result<coma::model::MotionModel> {
+    Ok(coma::model::MotionModel::load(
+        dir,
+        &burn::tensor::Device::flex(),
+    )?)
 }
 
-/// `--part "left arm=…"` arguments as per-part embeddings.
-fn parse_parts(
-    parts: &[String],
-    text: &coma::text::minilm::SentenceEncoder,
-) -> Result<Vec<(coma::skeleton::BodyPart, [f32; 384])>> {
+/// `--part "left arm=…"` arguments as (part, instruction).
+fn parse_parts(parts: &[String]) -> Result<Vec<(coma::skeleton::BodyPart, String)>> {
     parts
         .iter()
         .map(|p| {
             let (name, instruction) = p.split_once('=').ok_or_else(|| anyhow::anyhow!("--part '{p}': expected 'left arm=instruction'"))?;
             let part = coma::skeleton::BodyPart::parse(name)
                 .ok_or_else(|| anyhow::anyhow!("--part '{p}': unknown body part '{name}' (left arm, right arm, left leg, right leg)"))?;
-            Ok((part, text.encode(&[instruction.trim()])[0]))
+            Ok((part, instruction.trim().to_string()))
         })
         .collect()
 }
@@ -622,16 +613,10 @@ fn evaluate(
         }
     }
     eprintln!("embedded {} distinct captions", sentences.len());
-    let spam = match spam_dir {
-        Some(dir) => Some((
-            load_model(dir)?,
-            coma::model::model_id_of_dir(dir, &coma::model::WEIGHT_FILES)?,
-        )),
-        None => None,
-    };
+    let spam = spam_dir.map(load_model).transpose()?;
     let mut sources = vec![("real", Source::Real), ("retrieval", Source::Retrieval)];
-    if let Some(((s, _, _), _)) = &spam {
-        sources.push(("spam", Source::Spam(s)));
+    if let Some(model) = &spam {
+        sources.push(("spam", Source::Spam(&model.spam)));
     }
     let protocol = Protocol {
         evaluator: &evaluator,
@@ -643,13 +628,8 @@ fn evaluate(
     };
     let rows = protocol.run(&sources, options, &|l| eprintln!("{l}"))?;
     let mut probes = Probes::default();
-    if let Some(((s, normalizer, text), _)) = &spam {
-        use coma::eval::probes::{continuity, edit_locality, left_right, Generator};
-        let generator = Generator {
-            spam: s,
-            text,
-            normalizer,
-        };
+    if let Some(generator) = &spam {
+        use coma::eval::probes::{continuity, edit_locality, left_right};
         eprintln!("probes: left/right over {probe_seeds} seeds a prompt");
         let lr = left_right(&generator, probe_seeds, 4.0);
         probes.left_right_rate = Some(lr.rate);
@@ -687,7 +667,7 @@ fn evaluate(
     let report = EvalReport {
         command,
         evaluator_id,
-        spam_id: spam.as_ref().map(|(_, id)| id.clone()),
+        spam_id: spam.as_ref().map(|m| m.id.clone()),
         test_motions: test.items.iter().filter(|i| !i.captions.is_empty()).count(),
         options: options.clone(),
         rows,
@@ -884,18 +864,16 @@ fn run(cli: Cli) -> Result<()> {
             png,
             model,
         } => {
-            let (spam, normalizer, text) = load_model(&model.models)?;
-            let global = text.encode(&[prompt.as_str()])[0];
-            let overrides = parse_parts(&parts, &text)?;
-            let condition = coma::model::edit::part_text(&global, &overrides);
-            let options = coma::model::generate::SamplingOptions {
-                seed,
-                ..Default::default()
-            };
-            let frames = (seconds * coma::features::FPS).round().max(4.0) as usize;
-            let tokens = spam.generate(&condition, frames, &options);
-            let features = normalizer.denormalize(&spam.decode(&tokens));
-            write_outputs(&features, out.as_deref(), png.as_deref(), &prompt)?;
+            let parts = parse_parts(&parts)?;
+            let model = load_model(&model.models)?;
+            let frames = coma::model::motion_model::frames_for_seconds(seconds);
+            let tokens = model.generate(&prompt, &parts, frames, seed);
+            write_outputs(
+                &model.features(&tokens),
+                out.as_deref(),
+                png.as_deref(),
+                &prompt,
+            )?;
         }
         Command::Edit {
             input,
@@ -908,7 +886,7 @@ fn run(cli: Cli) -> Result<()> {
             png,
             model,
         } => {
-            let (spam, normalizer, text) = load_model(&model.models)?;
+            let model = load_model(&model.models)?;
             let motion = match read_motion(&input)? {
                 coma::motion_file::MotionData::Features(f) => f,
                 _ => bail!(
@@ -916,22 +894,16 @@ fn run(cli: Cli) -> Result<()> {
                     input.display()
                 ),
             };
-            let tokens = spam.tokenize(&normalizer.normalize(&motion));
-            let embedding = text.encode(&[instruction.as_str()])[0];
-            let options = coma::model::generate::SamplingOptions {
-                seed,
-                ..Default::default()
-            };
+            let tokens = model.spam.tokenize(&model.normalizer.normalize(&motion));
             let edited = match (from, to, parts.is_empty()) {
                 (Some(a), Some(b), true) => {
-                    let condition = coma::model::edit::part_text(&embedding, &[]);
                     let fps = coma::features::FPS;
-                    spam.inbetween(
+                    model.inbetween(
                         &tokens,
-                        &condition,
+                        &instruction,
                         (a * fps) as usize,
                         (b * fps).ceil() as usize,
-                        &options,
+                        seed,
                     )
                 }
                 (None, None, false) => {
@@ -942,20 +914,17 @@ fn run(cli: Cli) -> Result<()> {
                                 .ok_or_else(|| anyhow::anyhow!("unknown body part '{p}' (left arm, right arm, left leg, right leg)"))
                         })
                         .collect::<Result<Vec<_>>>()?;
-                    let overrides: Vec<_> = chosen.iter().map(|p| (*p, embedding)).collect();
                     // The other parts keep doing what the motion does, as the describer puts it.
-                    let description = coma::posecodes::describe_motion(
+                    let rest = coma::posecodes::describe_motion(
                         &coma::features::features_to_joints(&motion),
                     );
-                    let rest = text.encode(&[description.as_str()])[0];
-                    let condition = coma::model::edit::part_text(&rest, &overrides);
-                    spam.edit_parts(&tokens, &condition, &chosen, &options)
+                    model.edit_parts(&tokens, &instruction, &chosen, &rest, seed)
                 }
                 _ => bail!(
                     "give either --from and --to (in-between edit) or --parts (body-part edit)"
                 ),
             };
-            let features = normalizer.denormalize(&spam.decode(&edited));
+            let features = model.features(&edited);
             write_outputs(&features, Some(&out), png.as_deref(), &instruction)?;
         }
         Command::Bench {
@@ -1028,6 +997,41 @@ fn run(cli: Cli) -> Result<()> {
                 "{:.1}",
                 coma::eval::evaluator::alignment_score(&t[0], &m[0])
             );
+        }
+        Command::Export {
+            what: ExportWhat::Random,
+            data,
+            out,
+            ..
+        } => {
+            use burn::config::Config;
+            use burn::module::Module;
+            let sizes = coma::model::SpamConfig::load("configs/spam.json")
+                .map_err(|e| anyhow::anyhow!("configs/spam.json: {e}"))?;
+            let device = burn::tensor::Device::flex();
+            let spam = coma::model::Spam::random(&sizes.vq, &sizes.base, &sizes.residual, &device);
+            std::fs::create_dir_all(&out)?;
+            sizes
+                .save(out.join("spam.json"))
+                .map_err(|e| anyhow::anyhow!("writing spam.json: {e}"))?;
+            let save = |r: Result<(), _>, name: &str| {
+                r.map_err(|e| anyhow::anyhow!("writing {name}: {e:?}"))
+            };
+            save(spam.vq.clone().save_file(out.join("vq.bpk")), "vq.bpk")?;
+            save(
+                spam.base.clone().save_file(out.join("base.bpk")),
+                "base.bpk",
+            )?;
+            save(
+                spam.residual.clone().save_file(out.join("residual.bpk")),
+                "residual.bpk",
+            )?;
+            for (from, to) in [("Mean.npy", "mean.npy"), ("Std.npy", "std.npy")] {
+                std::fs::copy(data.join(from), out.join(to))
+                    .with_context(|| format!("copying {}", data.join(from).display()))?;
+            }
+            coma::model::Spam::load(&out, &device)?;
+            println!("wrote SPAM with random weights into {}", out.display());
         }
         Command::Export {
             what: ExportWhat::Evaluator,

@@ -7,7 +7,6 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeMap;
-use std::io::Read;
 use std::path::Path;
 
 /// One source clip with its labels.
@@ -145,26 +144,41 @@ pub fn read_clips(source: &Path, selection: &Selection) -> Result<Vec<SourceClip
     if source.is_dir() {
         visit(source, &mut collected)?;
     } else {
-        let file = std::fs::File::open(source)
-            .with_context(|| format!("cannot open {}", source.display()))?;
-        let mut archive =
-            tar::Archive::new(liblzma::read::XzDecoder::new(std::io::BufReader::new(file)));
-        for entry in archive
-            .entries()
-            .with_context(|| format!("{} is not a tar.xz archive", source.display()))?
-        {
-            let mut entry = entry.with_context(|| format!("reading {}", source.display()))?;
-            let path = entry.path()?.to_string_lossy().to_string();
-            if wanted(&path) {
-                let mut text = String::new();
-                entry
-                    .read_to_string(&mut text)
-                    .with_context(|| format!("reading {path} in {}", source.display()))?;
-                collected.add(&path, text);
-            }
-        }
+        read_archive(source, &mut collected)?;
     }
     collected.finish(selection)
+}
+
+#[cfg(feature = "native")]
+fn read_archive(source: &Path, collected: &mut Collected) -> Result<()> {
+    use std::io::Read;
+    let file =
+        std::fs::File::open(source).with_context(|| format!("cannot open {}", source.display()))?;
+    let mut archive =
+        tar::Archive::new(liblzma::read::XzDecoder::new(std::io::BufReader::new(file)));
+    for entry in archive
+        .entries()
+        .with_context(|| format!("{} is not a tar.xz archive", source.display()))?
+    {
+        let mut entry = entry.with_context(|| format!("reading {}", source.display()))?;
+        let path = entry.path()?.to_string_lossy().to_string();
+        if wanted(&path) {
+            let mut text = String::new();
+            entry
+                .read_to_string(&mut text)
+                .with_context(|| format!("reading {path} in {}", source.display()))?;
+            collected.add(&path, text);
+        }
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "native"))]
+fn read_archive(source: &Path, _: &mut Collected) -> Result<()> {
+    anyhow::bail!(
+        "{}: reading .tar.xz archives needs the native build (feature `native`)",
+        source.display()
+    )
 }
 
 fn visit(dir: &Path, collected: &mut Collected) -> Result<()> {

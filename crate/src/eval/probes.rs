@@ -5,36 +5,11 @@
 //! - edit locality: editing one arm of a motion must leave the legs where they were;
 //! - continuity: the join of two blended segments must not be faster than real motion ever is.
 
-use crate::features::{self, FeatureFrame, Normalizer, FPS};
+use crate::features::FPS;
 use crate::geom;
-use crate::model::edit::{part_text, PartText};
-use crate::model::generate::{MotionTokens, SamplingOptions};
-use crate::model::Spam;
+use crate::model::motion_model::sampling;
+use crate::model::MotionModel;
 use crate::skeleton::{joint, BodyPart, Pose};
-use crate::text::minilm::SentenceEncoder;
-
-/// SPAM with its text encoder and feature statistics: what a probe needs to generate.
-pub struct Generator<'a> {
-    pub spam: &'a Spam,
-    pub text: &'a SentenceEncoder,
-    pub normalizer: &'a Normalizer,
-}
-
-impl Generator<'_> {
-    fn condition(&self, prompt: &str) -> PartText {
-        part_text(&self.text.encode(&[prompt])[0], &[])
-    }
-
-    /// Joint positions of tokens.
-    pub fn joints(&self, tokens: &MotionTokens) -> Vec<Pose> {
-        features::features_to_joints(&self.features(tokens))
-    }
-
-    /// Features (not normalised) of tokens.
-    pub fn features(&self, tokens: &MotionTokens) -> Vec<FeatureFrame> {
-        self.normalizer.denormalize(&self.spam.decode(tokens))
-    }
-}
 
 /// Result of the left/right probe.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -56,7 +31,7 @@ fn wrist_rise(poses: &[Pose], wrist: usize) -> f64 {
 
 /// Raises and waves each hand with `seeds` seeds each; a sample is correct when the asked
 /// wrist rises more than the other one.
-pub fn left_right(generator: &Generator, seeds: u64, seconds: f64) -> LeftRightReport {
+pub fn left_right(model: &MotionModel, seeds: u64, seconds: f64) -> LeftRightReport {
     let prompts = [
         (
             "a person raises the left hand",
@@ -83,18 +58,9 @@ pub fn left_right(generator: &Generator, seeds: u64, seconds: f64) -> LeftRightR
     let mut rows = Vec::new();
     let (mut good, mut total) = (0, 0);
     for (prompt, asked, other) in prompts {
-        let condition = generator.condition(prompt);
         let correct = (0..seeds)
             .filter(|seed| {
-                let tokens = generator.spam.generate(
-                    &condition,
-                    frames,
-                    &SamplingOptions {
-                        seed: *seed,
-                        ..Default::default()
-                    },
-                );
-                let poses = generator.joints(&tokens);
+                let poses = model.joints(&model.generate(prompt, &[], frames, *seed));
                 wrist_rise(&poses, asked) > wrist_rise(&poses, other)
             })
             .count();
@@ -120,32 +86,14 @@ pub struct LocalityReport {
 /// Generates `base` (a walk), edits the left arm with `instruction`, and measures how much the
 /// legs moved (root-relative, so a changed path does not count) and what the arm did.
 pub fn edit_locality(
-    generator: &Generator,
+    model: &MotionModel,
     base: &str,
     instruction: &str,
     seed: u64,
 ) -> LocalityReport {
-    let condition = generator.condition(base);
-    let options = SamplingOptions {
-        seed,
-        ..Default::default()
-    };
-    let original = generator.spam.generate(&condition, 120, &options);
-    let arm = generator.text.encode(&[instruction])[0];
-    let edited_text = part_text(
-        &generator.text.encode(&[base])[0],
-        &[(BodyPart::LeftArm, arm)],
-    );
-    let edited = generator.spam.edit_parts(
-        &original,
-        &edited_text,
-        &[BodyPart::LeftArm],
-        &SamplingOptions {
-            seed: seed + 1,
-            ..Default::default()
-        },
-    );
-    let (a, b) = (generator.joints(&original), generator.joints(&edited));
+    let original = model.generate(base, &[], 120, seed);
+    let edited = model.edit_parts(&original, instruction, &[BodyPart::LeftArm], base, seed + 1);
+    let (a, b) = (model.joints(&original), model.joints(&edited));
     let legs = [
         joint::L_HIP,
         joint::R_HIP,
@@ -248,41 +196,17 @@ impl ContinuityReport {
 /// Blends two generated segments and compares the speeds at the join with the 99th
 /// percentile of `reference` motions' frame-to-frame speeds.
 pub fn continuity(
-    generator: &Generator,
+    model: &MotionModel,
     first: &str,
     second: &str,
     reference: &[Vec<Pose>],
     seed: u64,
 ) -> ContinuityReport {
-    let (ta, tb) = (generator.condition(first), generator.condition(second));
-    let a = generator.spam.generate(
-        &ta,
-        100,
-        &SamplingOptions {
-            seed,
-            ..Default::default()
-        },
-    );
-    let b = generator.spam.generate(
-        &tb,
-        100,
-        &SamplingOptions {
-            seed: seed + 1,
-            ..Default::default()
-        },
-    );
-    let joined = generator.spam.blend(
-        &a,
-        &b,
-        &ta,
-        &tb,
-        2,
-        &SamplingOptions {
-            seed: seed + 2,
-            ..Default::default()
-        },
-    );
-    let poses = generator.joints(&joined);
+    let (ta, tb) = (model.condition(first, &[]), model.condition(second, &[]));
+    let a = model.generate(first, &[], 100, seed);
+    let b = model.generate(second, &[], 100, seed + 1);
+    let joined = model.spam.blend(&a, &b, &ta, &tb, 2, &sampling(seed + 2));
+    let poses = model.joints(&joined);
     let join = a[0][0].len() * crate::model::vq::DOWNSAMPLE;
     let speeds = frame_speeds(&poses);
     let near = &speeds[join.saturating_sub(2).min(speeds.len())..(join + 2).min(speeds.len())];

@@ -242,8 +242,9 @@ impl Protocol<'_> {
                                 let samples: Vec<Vec<FeatureFrame>> = (0..options
                                     .multimodality_samples)
                                     .map(|j| {
-                                        let seed = (1 << 40) + (repeat * 100_000 + k * 100 + j);
-                                        generate(s, length(k), seed as u64)
+                                        let seed =
+                                            (1u64 << 40) + (repeat * 100_000 + k * 100 + j) as u64;
+                                        generate(s, length(k), seed)
                                     })
                                     .collect();
                                 let refs: Vec<&[FeatureFrame]> =

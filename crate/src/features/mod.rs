@@ -388,8 +388,15 @@ impl Normalizer {
         mean: impl AsRef<std::path::Path>,
         std: impl AsRef<std::path::Path>,
     ) -> Result<Normalizer, NpyError> {
-        let m = NpyArray::read(mean)?;
-        let s = NpyArray::read(std)?;
+        Self::from_arrays(NpyArray::read(mean)?, NpyArray::read(std)?)
+    }
+
+    /// The statistics from the bytes of `Mean.npy` and `Std.npy` (in the page).
+    pub fn from_npy_bytes(mean: &[u8], std: &[u8]) -> Result<Normalizer, NpyError> {
+        Self::from_arrays(NpyArray::from_bytes(mean)?, NpyArray::from_bytes(std)?)
+    }
+
+    fn from_arrays(m: NpyArray, s: NpyArray) -> Result<Normalizer, NpyError> {
         m.expect_shape(&[Some(FEATURE_DIM)])?;
         s.expect_shape(&[Some(FEATURE_DIM)])?;
         Ok(Normalizer {

@@ -4,9 +4,11 @@
 
 pub mod edit;
 pub mod generate;
+pub mod motion_model;
 pub mod transformer;
 pub mod vq;
 
+pub use motion_model::MotionModel;
 use transformer::{BaseTransformer, ResidualTransformer, TransformerConfig};
 use vq::{MotionVq, VqConfig};
 
@@ -101,31 +103,83 @@ fn load_error(file: &std::path::Path, message: impl std::fmt::Display) -> SpamLo
     }
 }
 
+/// The contents of a SPAM model folder's files (see [`WEIGHT_FILES`]).
+pub struct SpamFiles<'a> {
+    pub config: &'a str,
+    pub vq: &'a [u8],
+    pub base: &'a [u8],
+    pub residual: &'a [u8],
+    pub mean: &'a [u8],
+    pub std: &'a [u8],
+}
+
 impl Spam {
+    /// SPAM and its feature statistics from the contents of its files (no file system, so it
+    /// works in the page).
+    pub fn from_bytes(
+        files: &SpamFiles,
+        device: &Device,
+    ) -> Result<(Spam, crate::features::Normalizer), SpamLoadError> {
+        let error = |file: &str, message: String| SpamLoadError::File {
+            file: file.to_string(),
+            message,
+        };
+        let config: SpamConfig =
+            serde_json::from_str(files.config).map_err(|e| error("spam.json", e.to_string()))?;
+        let mut spam = Spam::random(&config.vq, &config.base, &config.residual, device);
+        let record = |name: &str, bytes: &[u8]| {
+            burn::store::ModuleRecord::from_bytes(burn::tensor::Bytes::from_bytes_vec(
+                bytes.to_vec(),
+            ))
+            .map_err(|e| error(name, format!("{e:?}")))
+        };
+        spam.vq = spam
+            .vq
+            .try_load_record(record("vq.bpk", files.vq)?)
+            .map_err(|e| error("vq.bpk", format!("{e:?}")))?;
+        spam.base = spam
+            .base
+            .try_load_record(record("base.bpk", files.base)?)
+            .map_err(|e| error("base.bpk", format!("{e:?}")))?;
+        spam.residual = spam
+            .residual
+            .try_load_record(record("residual.bpk", files.residual)?)
+            .map_err(|e| error("residual.bpk", format!("{e:?}")))?;
+        let normalizer = crate::features::Normalizer::from_npy_bytes(files.mean, files.std)
+            .map_err(|e| error("mean.npy/std.npy", e.to_string()))?;
+        Ok((spam, normalizer))
+    }
+
     /// Loads `spam.json`, `vq.bpk`, `base.bpk`, `residual.bpk` and the feature statistics
     /// `mean.npy`/`std.npy` from a folder (the default model lives in `static/models`).
     pub fn load(
         dir: &std::path::Path,
         device: &Device,
     ) -> Result<(Spam, crate::features::Normalizer), SpamLoadError> {
-        let config_path = dir.join("spam.json");
-        let config = SpamConfig::load(&config_path).map_err(|e| load_error(&config_path, e))?;
-        let mut spam = Spam::random(&config.vq, &config.base, &config.residual, device);
-        let file = |name: &str| dir.join(name);
-        spam.vq = spam
-            .vq
-            .try_load_file(file("vq.bpk"))
-            .map_err(|e| load_error(&file("vq.bpk"), format!("{e:?}")))?;
-        spam.base = spam
-            .base
-            .try_load_file(file("base.bpk"))
-            .map_err(|e| load_error(&file("base.bpk"), format!("{e:?}")))?;
-        spam.residual = spam
-            .residual
-            .try_load_file(file("residual.bpk"))
-            .map_err(|e| load_error(&file("residual.bpk"), format!("{e:?}")))?;
-        let normalizer = crate::features::Normalizer::read(file("mean.npy"), file("std.npy"))
-            .map_err(|e| load_error(&file("mean.npy"), e))?;
-        Ok((spam, normalizer))
+        let read =
+            |name: &str| std::fs::read(dir.join(name)).map_err(|e| load_error(&dir.join(name), e));
+        let bytes: Vec<Vec<u8>> = WEIGHT_FILES
+            .iter()
+            .map(|f| read(f))
+            .collect::<Result<_, _>>()?;
+        let config =
+            std::str::from_utf8(&bytes[0]).map_err(|e| load_error(&dir.join("spam.json"), e))?;
+        Spam::from_bytes(
+            &SpamFiles {
+                config,
+                vq: &bytes[1],
+                base: &bytes[2],
+                residual: &bytes[3],
+                mean: &bytes[4],
+                std: &bytes[5],
+            },
+            device,
+        )
+        .map_err(
+            |SpamLoadError::File { file, message }| SpamLoadError::File {
+                file: dir.join(file).display().to_string(),
+                message,
+            },
+        )
     }
 }

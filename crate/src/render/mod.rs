@@ -464,7 +464,7 @@ impl Screen<'_> {
 }
 
 /// The colour of a joint's dot: its limb's, or the torso's.
-fn joint_color(j: usize) -> [u8; 3] {
+pub fn joint_color(j: usize) -> [u8; 3] {
     PART_COLORS
         .iter()
         .find(|(part, _)| part.limb_joints().contains(&j))
@@ -473,7 +473,7 @@ fn joint_color(j: usize) -> [u8; 3] {
 
 /// The colour of the bone from `parent` to `child`: a limb's only when both ends are in the
 /// limb, so the pelvis→hip and spine3→collar bones stay with the torso.
-fn bone_color(parent: usize, child: usize) -> [u8; 3] {
+pub fn bone_color(parent: usize, child: usize) -> [u8; 3] {
     PART_COLORS
         .iter()
         .find(|(part, _)| {

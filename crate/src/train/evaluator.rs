@@ -117,19 +117,22 @@ fn learning_rate(config: &EvaluatorTrainingConfig, step: usize) -> f64 {
     config.learning_rate * warm * decay
 }
 
-/// Top-3 R-precision (batches of 32) of the evaluator on motions and their first caption.
+/// Top-3 R-precision (batches of 32) of the evaluator on motions and their first caption,
+/// in a fixed shuffled order (the split lists similar clips next to each other, which would
+/// make every batch a set of near-twins).
 pub fn retrieval_top3(
     model: &Evaluator,
     config: &EvaluatorConfig,
     data: &CaptionedMotions,
     device: &Device,
 ) -> f64 {
-    let refs: Vec<&[FeatureFrame]> = data.motions.iter().map(Vec::as_slice).collect();
+    let mut order: Vec<usize> = (0..data.motions.len()).collect();
+    Rng::new(32).shuffle(&mut order);
+    let refs: Vec<&[FeatureFrame]> = order.iter().map(|&i| data.motions[i].as_slice()).collect();
     let motions = model.embed_motions(config, &refs, device);
-    let sentences: Vec<[f32; TEXT_DIM]> = data
-        .captions
+    let sentences: Vec<[f32; TEXT_DIM]> = order
         .iter()
-        .map(|c| data.embeddings[c[0]])
+        .map(|&i| data.embeddings[data.captions[i][0]])
         .collect();
     let texts = model.embed_texts(&sentences, device);
     r_precision(&texts, &motions, 32)[2]

@@ -1,0 +1,174 @@
+//! SPAM with its sentence encoder and feature statistics: everything that turns words into
+//! motion. The command line, the probes, the evaluation and the page's worker all go through
+//! it, so a prompt means the same motion everywhere.
+
+use super::edit::{part_text, PartText};
+use super::generate::{MotionTokens, SamplingOptions};
+use super::{Spam, SpamFiles, SpamLoadError, WEIGHT_FILES};
+use crate::features::{features_to_joints, Features, Normalizer, FPS};
+use crate::skeleton::{BodyPart, Pose};
+use crate::text::minilm::{MiniLmError, SentenceEncoder};
+use burn::prelude::*;
+
+/// Longest motion one generation makes: 196 frames, 9.8 s at 20 fps.
+pub const MAX_FRAMES: usize = 196;
+
+/// Why a motion model could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum MotionModelError {
+    #[error(transparent)]
+    Spam(#[from] SpamLoadError),
+    #[error("sentence encoder: {0}")]
+    Text(#[from] MiniLmError),
+    #[error("{0}")]
+    Io(String),
+}
+
+/// The contents of the sentence encoder's three files.
+pub struct TextFiles<'a> {
+    pub vocab: &'a str,
+    pub words: &'a [u8],
+    pub model: &'a [u8],
+}
+
+/// The three networks of SPAM, the sentence encoder and the statistics that undo the
+/// features' normalisation.
+pub struct MotionModel {
+    pub spam: Spam,
+    pub normalizer: Normalizer,
+    pub text: SentenceEncoder,
+    /// The model id (see [`super::model_id`]): share links name the model by it.
+    pub id: String,
+}
+
+impl MotionModel {
+    /// A model from the contents of its files (no file system, so it works in the page).
+    pub fn from_files(
+        spam: &SpamFiles,
+        text: &TextFiles,
+        device: &Device,
+    ) -> Result<MotionModel, MotionModelError> {
+        let id = super::model_id(&[
+            spam.config.as_bytes(),
+            spam.vq,
+            spam.base,
+            spam.residual,
+            spam.mean,
+            spam.std,
+        ]);
+        let (spam, normalizer) = Spam::from_bytes(spam, device)?;
+        let text = SentenceEncoder::from_bytes(text.vocab, text.words, text.model, device)?;
+        Ok(MotionModel {
+            spam,
+            normalizer,
+            text,
+            id,
+        })
+    }
+
+    /// The model in a folder (the default one is `static/models`).
+    pub fn load(dir: &std::path::Path, device: &Device) -> Result<MotionModel, MotionModelError> {
+        let (spam, normalizer) = Spam::load(dir, device)?;
+        let text = SentenceEncoder::from_dir(dir, device)?;
+        let id = super::model_id_of_dir(dir, &WEIGHT_FILES)
+            .map_err(|e| MotionModelError::Io(format!("{}: {e}", dir.display())))?;
+        Ok(MotionModel {
+            spam,
+            normalizer,
+            text,
+            id,
+        })
+    }
+
+    /// The condition of every part: `prompt`'s embedding, replaced by their own
+    /// instruction's for the parts in `parts`.
+    pub fn condition(&self, prompt: &str, parts: &[(BodyPart, String)]) -> PartText {
+        // One sentence at a time: a batch pads, and padding may move the last bits of an
+        // embedding, which would change what a seed samples.
+        let embed = |t: &str| self.text.encode(&[t])[0];
+        let overrides: Vec<_> = parts.iter().map(|(p, t)| (*p, embed(t))).collect();
+        part_text(&embed(prompt), &overrides)
+    }
+
+    /// A new motion of about `frames` frames (4 to [`MAX_FRAMES`], in steps of 4).
+    pub fn generate(
+        &self,
+        prompt: &str,
+        parts: &[(BodyPart, String)],
+        frames: usize,
+        seed: u64,
+    ) -> MotionTokens {
+        self.spam.generate(
+            &self.condition(prompt, parts),
+            frames.clamp(4, MAX_FRAMES),
+            &sampling(seed),
+        )
+    }
+
+    /// Frames `from..to` (20 fps) of every part regenerated from `text`.
+    pub fn inbetween(
+        &self,
+        tokens: &MotionTokens,
+        text: &str,
+        from: usize,
+        to: usize,
+        seed: u64,
+    ) -> MotionTokens {
+        self.spam.inbetween(
+            tokens,
+            &self.condition(text, &[]),
+            from,
+            to,
+            &sampling(seed),
+        )
+    }
+
+    /// The `parts` regenerated from `instruction`; the other parts are conditioned on
+    /// `rest`, what the whole motion does (its prompt, or a description of it).
+    pub fn edit_parts(
+        &self,
+        tokens: &MotionTokens,
+        instruction: &str,
+        parts: &[BodyPart],
+        rest: &str,
+        seed: u64,
+    ) -> MotionTokens {
+        let overrides: Vec<_> = parts
+            .iter()
+            .map(|p| (*p, instruction.to_string()))
+            .collect();
+        self.spam.edit_parts(
+            tokens,
+            &self.condition(rest, &overrides),
+            parts,
+            &sampling(seed),
+        )
+    }
+
+    /// The features (not normalised) of tokens.
+    pub fn features(&self, tokens: &MotionTokens) -> Features {
+        self.normalizer.denormalize(&self.spam.decode(tokens))
+    }
+
+    /// Joint positions of tokens (metres, 20 fps).
+    pub fn joints(&self, tokens: &MotionTokens) -> Vec<Pose> {
+        features_to_joints(&self.features(tokens))
+    }
+}
+
+/// Default sampling with a seed.
+pub fn sampling(seed: u64) -> SamplingOptions {
+    SamplingOptions {
+        seed,
+        ..Default::default()
+    }
+}
+
+/// Frames for a length in seconds, within what one generation makes.
+pub fn frames_for_seconds(seconds: f64) -> usize {
+    if seconds.is_finite() {
+        ((seconds * FPS).round().max(4.0) as usize).min(MAX_FRAMES)
+    } else {
+        MAX_FRAMES
+    }
+}

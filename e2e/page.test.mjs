@@ -1,0 +1,135 @@
+// End-to-end test of the page in headless Chromium: load, generate with no LLM, watch the
+// canvas move, share the link and rebuild the same motion from it in a fresh page, download a
+// BVH that our own reader parses, and take the screenshots under docs/.
+//
+// Needs: the built page in DIST (default ../dist), the coma binary in COMA (serves the page and
+// reads the BVH), /usr/bin/chromium.
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import { spawn, execFileSync } from "node:child_process";
+import { mkdtempSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join, resolve } from "node:path";
+import { chromium } from "playwright-core";
+
+const here = new URL(".", import.meta.url).pathname;
+const DIST = resolve(process.env.DIST ?? join(here, "../dist"));
+const COMA = process.env.COMA ?? "coma";
+const PORT = Number(process.env.PORT ?? 8097);
+const SHOTS = resolve(process.env.SHOTS ?? join(here, "../docs"));
+const BASE = `http://127.0.0.1:${PORT}/`;
+const LOAD_TIMEOUT = 10 * 60_000;
+
+// Software WebGPU (SwiftShader) for compute and canvas (ANGLE on SwiftShader too, or the
+// compositor shows WebGPU canvases blank in screenshots), and no calls out of the machine.
+const ARGS = [
+  "--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu-sandbox",
+  "--enable-unsafe-webgpu", "--enable-features=Vulkan", "--use-vulkan=swiftshader", "--use-angle=swiftshader",
+  "--disable-background-networking", "--disable-component-update", "--disable-sync",
+  "--no-first-run", "--disable-quic",
+];
+
+async function waitForServer() {
+  for (let i = 0; i < 100; i++) {
+    try {
+      const r = await fetch(BASE);
+      if (r.ok) return;
+    } catch {}
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  throw new Error(`the page server did not start on ${BASE}`);
+}
+
+/** Opens the page and records console errors, uncaught errors and bytes received. */
+async function open(context, url) {
+  const page = await context.newPage();
+  const problems = [];
+  const stats = { bytes: 0 };
+  page.on("console", (m) => { if (m.type() === "error") problems.push(`console: ${m.text()}`); });
+  page.on("pageerror", (e) => problems.push(`uncaught: ${e.message}`));
+  page.on("worker", (w) => w.on("console", (m) => { if (m.type() === "error") problems.push(`worker console: ${m.text()}`); }));
+  page.on("requestfinished", async (req) => {
+    try { const s = await req.sizes(); stats.bytes += s.responseBodySize + s.responseHeadersSize; } catch {}
+  });
+  await page.goto(url);
+  return { page, problems, stats };
+}
+
+async function modelLoaded(page) {
+  await page.waitForFunction(() => {
+    const b = document.querySelector("#generate");
+    return b && !b.disabled;
+  }, null, { timeout: LOAD_TIMEOUT });
+}
+
+async function canvasPixels(page) {
+  return (await page.locator("#view").screenshot()).toString("base64");
+}
+
+test("the page generates, plays, shares, rebuilds and exports a motion", { timeout: 30 * 60_000 }, async () => {
+  const server = spawn(COMA, ["serve", DIST, "--port", String(PORT)], { stdio: "inherit" });
+  const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
+  try {
+    await waitForServer();
+    const context = await browser.newContext({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
+    const first = await open(context, BASE);
+    const { page } = first;
+    await modelLoaded(page);
+    console.log(`first load: ${(first.stats.bytes / 1e6).toFixed(2)} MB transferred`);
+    const modelLine = await page.locator("#model-line").textContent();
+    console.log(`backend: ${modelLine}`);
+
+    await page.fill("#prompt", "a person walks forward");
+    await page.fill("#seconds", "9.8");
+    await page.locator("#seconds").dispatchEvent("change");
+    const started = Date.now();
+    await page.click("#generate");
+    await page.waitForFunction(() => Number(document.querySelector(".viewer")?.dataset.frames) > 0, null, { timeout: LOAD_TIMEOUT });
+    const frames = Number(await page.locator(".viewer").getAttribute("data-frames"));
+    const status = await page.locator("#status").textContent();
+    console.log(`generated ${frames} frames in ${((Date.now() - started) / 1000).toFixed(1)} s in the page (${status})`);
+    assert.ok(Math.abs(frames - 196) <= 4, `asked 196 frames, got ${frames}`);
+
+    // The motion plays: the canvas changes over time.
+    const a = await canvasPixels(page);
+    await page.waitForTimeout(700);
+    const b = await canvasPixels(page);
+    assert.notEqual(a, b, "the canvas did not change while playing");
+    const hash = await page.locator(".viewer").getAttribute("data-joints-hash");
+    assert.match(hash, /^[0-9a-f]{16}$/);
+    await page.screenshot({ path: join(SHOTS, "page-1280x800.png") });
+
+    // Share: the link rebuilds the same motion in a fresh page.
+    await page.click("#share");
+    const link = await page.locator("#share-link").inputValue();
+    assert.match(link, /#m=/);
+    const other = await browser.newContext({ viewport: { width: 390, height: 844 } });
+    const second = await open(other, link);
+    await second.page.waitForFunction((h) => document.querySelector(".viewer")?.dataset.jointsHash === h, hash, { timeout: LOAD_TIMEOUT });
+    await second.page.waitForTimeout(500);
+    await second.page.screenshot({ path: join(SHOTS, "page-390x844.png"), fullPage: true });
+
+    // A broken link gives a message and the page stays usable.
+    const third = await open(other, BASE + "#m=not-a-link");
+    await modelLoaded(third.page);
+    const message = await third.page.locator("#status").textContent();
+    assert.match(message, /cannot be opened/);
+
+    // Download a BVH and read it with our own reader.
+    const [download] = await Promise.all([
+      page.waitForEvent("download"),
+      page.click('button[data-format="motion.bvh"]'),
+    ]);
+    const dir = mkdtempSync(join(tmpdir(), "coma-e2e-"));
+    const bvh = join(dir, "motion.bvh");
+    await download.saveAs(bvh);
+    execFileSync(COMA, ["convert", bvh, join(dir, "motion.json")]);
+
+    for (const p of [first, second, third]) {
+      assert.deepEqual(p.problems, [], "errors in the browser console");
+    }
+  } finally {
+    await browser.close();
+    server.kill();
+  }
+});

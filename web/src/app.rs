@@ -1,0 +1,293 @@
+//! The page: shared state in context, the worker's replies turned into state, and the layout
+//! of the components (prompt, viewer, timeline, toolbar, about).
+
+use crate::client::Client;
+use crate::history::History;
+use crate::messages::{Backend, Reply, Request};
+use crate::take::{segments_from_plan, Segment, Take};
+use crate::ui::{
+    about::About, prompt::PromptBox, status::StatusBar, timeline::Timeline, toolbar::Toolbar,
+    viewer::Viewer,
+};
+use coma::share::{self, Edit, EditKind};
+use leptos::prelude::*;
+
+/// Undo keeps this many states.
+const HISTORY_LIMIT: usize = 100;
+
+/// The loaded model as the worker described it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelInfo {
+    pub id: String,
+    pub backend: Backend,
+    pub note: Option<String>,
+    pub bytes: u64,
+    pub millis: f64,
+}
+
+/// A line for the user: what happened, or what went wrong and what to do.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Status {
+    pub text: String,
+    pub error: bool,
+}
+
+/// What a request in flight will become when its motion arrives.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pending {
+    /// A new take from the prompt.
+    Generate { prompt: String, seed: u64 },
+    /// An edit of the current take.
+    Edit(Edit),
+    /// A take rebuilt from a share link.
+    Link(share::SharedMotion),
+}
+
+/// State every component reads through context.
+#[derive(Clone, Copy)]
+pub struct AppState {
+    pub status: RwSignal<Status>,
+    pub progress: RwSignal<Option<(String, u64, u64)>>,
+    pub model: RwSignal<Option<ModelInfo>>,
+    pub history: RwSignal<History<Option<Take>>>,
+    pub pending: RwSignal<Option<Pending>>,
+    /// The playhead, in frames (fractional while playing).
+    pub frame: RwSignal<f64>,
+    pub playing: RwSignal<bool>,
+    pub speed: RwSignal<f64>,
+    /// Milliseconds the last generation took in the worker.
+    pub generate_millis: RwSignal<Option<f64>>,
+    /// A link made with another model, waiting for the user to regenerate it.
+    pub foreign_link: RwSignal<Option<share::SharedMotion>>,
+    pub client: StoredValue<Option<Client>, LocalStorage>,
+}
+
+impl AppState {
+    /// The current take, if any.
+    pub fn take(&self) -> Option<Take> {
+        self.history.with(|h| h.current().clone())
+    }
+
+    pub fn busy(&self) -> bool {
+        self.pending.with(Option::is_some)
+    }
+
+    pub fn say(&self, text: impl Into<String>) {
+        self.status.set(Status {
+            text: text.into(),
+            error: false,
+        });
+    }
+
+    pub fn fail(&self, text: impl Into<String>) {
+        self.status.set(Status {
+            text: text.into(),
+            error: true,
+        });
+    }
+
+    /// Sends a request whose motion becomes `pending`; refused while another one runs.
+    pub fn request(&self, request: Request, pending: Pending) {
+        if self.busy() {
+            self.fail("wait for the current step to finish");
+            return;
+        }
+        if self.model.with(Option::is_none) {
+            self.fail("the model is still loading");
+            return;
+        }
+        let sent = self.client.with_value(|c| match c {
+            Some(c) => c.send(&request),
+            None => Err("the model worker is not running".into()),
+        });
+        match sent {
+            Ok(()) => {
+                self.pending.set(Some(pending));
+                self.progress.set(Some(("working".into(), 0, 1)));
+            }
+            Err(e) => self.fail(e),
+        }
+    }
+
+    /// Writes the current take into the URL fragment, so the address is the share link.
+    fn publish(&self) {
+        let (Some(take), Some(model)) = (self.take(), self.model.get_untracked()) else {
+            return;
+        };
+        if let Some(id) = share::model_id_bytes(&model.id) {
+            crate::browser::set_fragment(&share::encode(&take.shared(id)));
+        }
+    }
+}
+
+fn on_reply(state: AppState, reply: Reply) {
+    match reply {
+        Reply::Ready => {
+            state.say("downloading the model…");
+            let sent = state.client.with_value(|c| {
+                c.as_ref().map(|c| {
+                    c.send(&Request::Load {
+                        base: crate::browser::absolute_url("static/models/"),
+                    })
+                })
+            });
+            if let Some(Err(e)) = sent {
+                state.fail(e);
+            }
+        }
+        Reply::Progress { stage, done, total } => state.progress.set(Some((stage, done, total))),
+        Reply::Loaded {
+            model_id,
+            backend,
+            note,
+            bytes,
+            millis,
+        } => {
+            state.progress.set(None);
+            state.say(format!(
+                "Model {model_id} loaded ({:.1} MB in {:.1} s). Type a prompt and press Generate.",
+                bytes as f64 / 1e6,
+                millis / 1000.0
+            ));
+            state.model.set(Some(ModelInfo {
+                id: model_id,
+                backend,
+                note,
+                bytes,
+                millis,
+            }));
+            open_link(state);
+        }
+        Reply::Motion { motion, millis } => {
+            state.progress.set(None);
+            let pending = state.pending.get_untracked();
+            state.pending.set(None);
+            let previous = state.take();
+            let frames = motion.joints.len();
+            let take = match pending {
+                Some(Pending::Generate { prompt, seed }) => {
+                    state.generate_millis.set(Some(millis));
+                    Take {
+                        motion,
+                        segments: vec![Segment {
+                            text: prompt.clone(),
+                            from: 0,
+                            to: frames,
+                        }],
+                        edits: vec![Edit {
+                            kind: EditKind::Generate,
+                            text: prompt.clone(),
+                            from_frame: 0,
+                            to_frame: frames as u32,
+                            parts: 0,
+                            seed,
+                        }],
+                        prompt,
+                        seed,
+                    }
+                }
+                Some(Pending::Edit(edit)) => match previous {
+                    Some(mut take) => {
+                        take.motion = motion;
+                        take.edits.push(edit);
+                        take
+                    }
+                    None => return state.fail("there was no motion to edit"),
+                },
+                Some(Pending::Link(link)) => Take {
+                    segments: segments_from_plan(&link.plan, &link.prompt, frames),
+                    motion,
+                    prompt: link.prompt,
+                    seed: link.seed,
+                    edits: link.history,
+                },
+                None => return,
+            };
+            state.history.update(|h| h.push(Some(take)));
+            state.frame.set(0.0);
+            state.playing.set(true);
+            state.publish();
+            state.say(format!("Done in {:.1} s.", millis / 1000.0));
+        }
+        Reply::Error { message } => {
+            state.progress.set(None);
+            state.pending.set(None);
+            state.fail(message);
+        }
+    }
+}
+
+/// Opens the share link in the URL, if there is one.
+fn open_link(state: AppState) {
+    let fragment = crate::browser::fragment();
+    if fragment.is_empty() {
+        return;
+    }
+    match share::decode(&fragment) {
+        Err(share::LinkError::NotALink) => {}
+        Err(e) => state.fail(format!("This link cannot be opened: {e}.")),
+        Ok(link) => {
+            let ours = state
+                .model
+                .with_untracked(|m| m.as_ref().map(|m| m.id.clone()))
+                .unwrap_or_default();
+            if share::model_id_hex(&link.model_id) != ours {
+                state.fail(format!(
+                    "This link was made with model {}, and this page has model {ours}: the motion cannot be rebuilt exactly. You can regenerate it from its prompt.",
+                    share::model_id_hex(&link.model_id)
+                ));
+                state.foreign_link.set(Some(link));
+            } else {
+                state.say("opening the shared motion…");
+                state.request(
+                    Request::Decode {
+                        tokens: link.tokens.clone(),
+                    },
+                    Pending::Link(link),
+                );
+            }
+        }
+    }
+}
+
+#[component]
+pub fn App() -> impl IntoView {
+    let state = AppState {
+        status: RwSignal::new(Status {
+            text: "starting…".into(),
+            error: false,
+        }),
+        progress: RwSignal::new(None),
+        model: RwSignal::new(None),
+        history: RwSignal::new(History::new(None, HISTORY_LIMIT)),
+        pending: RwSignal::new(None),
+        frame: RwSignal::new(0.0),
+        playing: RwSignal::new(false),
+        speed: RwSignal::new(1.0),
+        generate_millis: RwSignal::new(None),
+        foreign_link: RwSignal::new(None),
+        client: StoredValue::new_local(None),
+    };
+    provide_context(state);
+    match Client::spawn("./static/worker.js", move |reply| on_reply(state, reply)) {
+        Ok(client) => state.client.set_value(Some(client)),
+        Err(e) => state.fail(e),
+    }
+    view! {
+        <header>
+            <h1>"CoMA in the browser"</h1>
+            <About/>
+        </header>
+        <main>
+            <section class="left">
+                <PromptBox/>
+                <Timeline/>
+                <Toolbar/>
+            </section>
+            <section class="right">
+                <Viewer/>
+            </section>
+        </main>
+        <StatusBar/>
+    }
+}

@@ -1,0 +1,92 @@
+//! What the page asks of the browser: downloads, the clipboard, the URL fragment and the
+//! device pixel ratio. Every call reports failure as a message instead of panicking.
+
+use wasm_bindgen::JsCast;
+
+fn window() -> Result<web_sys::Window, String> {
+    web_sys::window().ok_or_else(|| "no browser window".to_string())
+}
+
+/// Offers `bytes` as a download named `name`.
+pub fn download(bytes: &[u8], name: &str, mime: &str) -> Result<(), String> {
+    let parts = js_sys::Array::new();
+    parts.push(&js_sys::Uint8Array::from(bytes));
+    let bag = web_sys::BlobPropertyBag::new();
+    bag.set_type(mime);
+    let blob = web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &bag)
+        .map_err(|e| format!("cannot prepare the download: {e:?}"))?;
+    let url = web_sys::Url::create_object_url_with_blob(&blob)
+        .map_err(|e| format!("cannot prepare the download: {e:?}"))?;
+    let document = window()?.document().ok_or("no document")?;
+    let anchor: web_sys::HtmlAnchorElement = document
+        .create_element("a")
+        .map_err(|e| format!("{e:?}"))?
+        .dyn_into()
+        .map_err(|_| "not an anchor")?;
+    anchor.set_href(&url);
+    anchor.set_download(name);
+    anchor.click();
+    // The click has started the download; the object URL is not needed after it.
+    let _ = web_sys::Url::revoke_object_url(&url);
+    Ok(())
+}
+
+/// Copies text to the clipboard (needs a user gesture, which the button gives).
+pub async fn copy_text(text: &str) -> Result<(), String> {
+    let promise = window()?.navigator().clipboard().write_text(text);
+    wasm_bindgen_futures::JsFuture::from(promise)
+        .await
+        .map(|_| ())
+        .map_err(|e| format!("the browser refused the clipboard: {e:?}"))
+}
+
+/// The URL fragment without its `#`.
+pub fn fragment() -> String {
+    window()
+        .and_then(|w| w.location().hash().map_err(|e| format!("{e:?}")))
+        .unwrap_or_default()
+        .trim_start_matches('#')
+        .to_string()
+}
+
+/// Replaces the URL fragment without a new history entry.
+pub fn set_fragment(fragment: &str) {
+    if let Ok(w) = window() {
+        if let Ok(history) = w.history() {
+            let _ = history.replace_state_with_url(
+                &wasm_bindgen::JsValue::NULL,
+                "",
+                Some(&format!("#{fragment}")),
+            );
+        }
+    }
+}
+
+/// `relative` resolved against the page's address (the worker resolves relative URLs against
+/// its own script, so it is given absolute ones).
+pub fn absolute_url(relative: &str) -> String {
+    web_sys::Url::new_with_base(relative, &href())
+        .map(|u| u.href())
+        .unwrap_or_else(|_| relative.to_string())
+}
+
+/// The whole page URL.
+pub fn href() -> String {
+    window()
+        .and_then(|w| w.location().href().map_err(|e| format!("{e:?}")))
+        .unwrap_or_default()
+}
+
+pub fn device_pixel_ratio() -> f64 {
+    window()
+        .map_or(1.0, |w| w.device_pixel_ratio())
+        .clamp(0.5, 4.0)
+}
+
+/// True when the browser offers WebGPU to this page.
+pub fn has_webgpu() -> bool {
+    window()
+        .ok()
+        .and_then(|w| js_sys::Reflect::get(&w.navigator(), &"gpu".into()).ok())
+        .is_some_and(|gpu| !gpu.is_undefined() && !gpu.is_null())
+}

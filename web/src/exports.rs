@@ -1,0 +1,155 @@
+//! The page's downloads, as bytes: BVH (our 22-joint skeleton at 20 fps, importable by
+//! Blender), JSON (joints per frame with the prompt and the plan) and NPY (HumanML3D's 263
+//! features, or the (T, 22, 3) joints).
+
+use crate::take::{plan_json, Take};
+use coma::features::{features_to_npy, joints_to_npy, FeatureFrame, FEATURE_DIM, FPS};
+use coma::skeleton::Pose;
+
+/// The export formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Bvh,
+    Json,
+    FeaturesNpy,
+    JointsNpy,
+}
+
+impl Format {
+    pub const ALL: [Format; 4] = [
+        Format::Bvh,
+        Format::Json,
+        Format::FeaturesNpy,
+        Format::JointsNpy,
+    ];
+
+    /// The button's label.
+    pub fn label(self) -> &'static str {
+        match self {
+            Format::Bvh => "BVH",
+            Format::Json => "JSON",
+            Format::FeaturesNpy => "NPY (features)",
+            Format::JointsNpy => "NPY (joints)",
+        }
+    }
+
+    /// File name of a download.
+    pub fn file_name(self) -> &'static str {
+        match self {
+            Format::Bvh => "motion.bvh",
+            Format::Json => "motion.json",
+            Format::FeaturesNpy => "motion-features.npy",
+            Format::JointsNpy => "motion-joints.npy",
+        }
+    }
+
+    /// MIME type of a download.
+    pub fn mime(self) -> &'static str {
+        match self {
+            Format::Bvh => "text/plain",
+            Format::Json => "application/json",
+            _ => "application/octet-stream",
+        }
+    }
+}
+
+fn poses(take: &Take) -> Vec<Pose> {
+    take.motion
+        .joints
+        .iter()
+        .map(|p| p.map(|j| j.map(|v| v as f64)))
+        .collect()
+}
+
+/// The bytes of `take` in `format`.
+pub fn export(take: &Take, format: Format) -> Result<Vec<u8>, String> {
+    match format {
+        Format::Bvh => coma::bvh::writer::write_bvh(&poses(take), FPS)
+            .map(String::into_bytes)
+            .map_err(|e| format!("cannot write BVH: {e}")),
+        Format::Json => {
+            let mut json = coma::motion_file::joints_to_json(&poses(take));
+            json["prompt"] = take.prompt.clone().into();
+            json["seed"] = take.seed.into();
+            json["plan"] =
+                serde_json::from_str(&plan_json(&take.segments)).unwrap_or(serde_json::Value::Null);
+            Ok(json.to_string().into_bytes())
+        }
+        Format::FeaturesNpy => {
+            let rows: Vec<FeatureFrame> = take
+                .motion
+                .features
+                .iter()
+                .map(|f| {
+                    let mut row = [0.0f32; FEATURE_DIM];
+                    for (r, v) in row.iter_mut().zip(f) {
+                        *r = *v;
+                    }
+                    row
+                })
+                .collect();
+            Ok(features_to_npy(&rows).to_bytes_f32())
+        }
+        Format::JointsNpy => Ok(joints_to_npy(&poses(take)).to_bytes_f32()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::messages::Motion;
+    use crate::take::Segment;
+
+    fn take() -> Take {
+        // A standing pose from the reference skeleton, swaying.
+        let offsets = coma::skeleton::Offsets::reference().0;
+        let mut rest = [[0.0f64; 3]; 22];
+        for j in 1..22 {
+            let p = coma::skeleton::PARENTS[j].unwrap();
+            rest[j] = std::array::from_fn(|k| rest[p][k] + offsets[j][k]);
+        }
+        let joints: Vec<[[f32; 3]; 22]> = (0..10)
+            .map(|t| {
+                rest.map(|j| {
+                    [
+                        j[0] as f32 + t as f32 * 0.01,
+                        j[1] as f32 + 0.9,
+                        j[2] as f32,
+                    ]
+                })
+            })
+            .collect();
+        Take {
+            motion: Motion {
+                tokens: vec![vec![vec![1, 2]; 4]; 4],
+                features: vec![vec![0.5; FEATURE_DIM]; 9],
+                joints,
+            },
+            prompt: "a person sways".into(),
+            seed: 3,
+            edits: vec![],
+            segments: vec![Segment {
+                text: "a person sways".into(),
+                from: 0,
+                to: 10,
+            }],
+        }
+    }
+
+    #[test]
+    fn exports_read_back_with_our_readers() {
+        let t = take();
+        let bvh = String::from_utf8(export(&t, Format::Bvh).unwrap()).unwrap();
+        let parsed = coma::bvh::Bvh::parse(&bvh).unwrap();
+        assert_eq!(parsed.frames.len(), 10);
+        let json: serde_json::Value =
+            serde_json::from_slice(&export(&t, Format::Json).unwrap()).unwrap();
+        assert_eq!(json["frames"].as_array().unwrap().len(), 10);
+        assert_eq!(json["prompt"], "a person sways");
+        assert_eq!(json["plan"]["segments"][0]["to"], 10);
+        let f = coma::npy::NpyArray::from_bytes(&export(&t, Format::FeaturesNpy).unwrap()).unwrap();
+        assert_eq!(f.shape, vec![9, FEATURE_DIM]);
+        let j = coma::npy::NpyArray::from_bytes(&export(&t, Format::JointsNpy).unwrap()).unwrap();
+        assert_eq!(j.shape, vec![10, 22, 3]);
+    }
+}

@@ -1,0 +1,270 @@
+//! The timeline: the motion's segments with their texts and the playhead; a time range and
+//! body parts to edit with an instruction (in-between or body-part edit); regenerating one
+//! segment; undo and redo.
+
+use crate::app::{AppState, Pending};
+use crate::messages::Request;
+use coma::share::{Edit, EditKind};
+use coma::skeleton::BodyPart;
+use leptos::prelude::*;
+
+const FPS: f64 = 20.0;
+
+/// A fresh seed for an edit: different from the take's, reproducible from it.
+fn next_seed(state: &AppState) -> u64 {
+    state
+        .take()
+        .map_or(1, |t| t.seed.wrapping_add(1 + t.edits.len() as u64))
+}
+
+#[component]
+pub fn Timeline() -> impl IntoView {
+    let state = expect_context::<AppState>();
+    let from = RwSignal::new(0.0f64);
+    let to = RwSignal::new(1.0f64);
+    let parts = RwSignal::new([false; 4]);
+    let instruction = RwSignal::new(String::new());
+    let frames = move || {
+        state
+            .history
+            .with(|h| h.current().as_ref().map_or(0, |t| t.frames()))
+    };
+    let has_take = move || frames() > 0;
+
+    let edit_range = move |_| {
+        let Some(take) = state.take() else { return };
+        let text = instruction.get_untracked().trim().to_string();
+        if text.is_empty() {
+            return state.fail("Type an instruction for the edit first.");
+        }
+        let (a, b) = (from.get_untracked(), to.get_untracked());
+        if !(a < b) {
+            return state.fail("The range must start before it ends.");
+        }
+        let (a, b) = ((a * FPS) as usize, (b * FPS).ceil() as usize);
+        let seed = next_seed(&state);
+        state.say("editing the range…");
+        state.request(
+            Request::InBetween {
+                tokens: take.motion.tokens.clone(),
+                text: text.clone(),
+                from: a,
+                to: b,
+                seed,
+            },
+            Pending::Edit(Edit {
+                kind: EditKind::InBetween,
+                text,
+                from_frame: a as u32,
+                to_frame: b as u32,
+                parts: 0,
+                seed,
+            }),
+        );
+    };
+    let edit_parts = move |_| {
+        let Some(take) = state.take() else { return };
+        let text = instruction.get_untracked().trim().to_string();
+        if text.is_empty() {
+            return state.fail("Type an instruction for the edit first.");
+        }
+        let chosen = parts.get_untracked();
+        if !chosen.contains(&true) {
+            return state.fail("Tick the body parts to edit first.");
+        }
+        let names: Vec<String> = BodyPart::ALL
+            .iter()
+            .zip(chosen)
+            .filter(|(_, c)| *c)
+            .map(|(p, _)| p.name().to_string())
+            .collect();
+        let mask = chosen
+            .iter()
+            .enumerate()
+            .fold(0u8, |m, (i, c)| if *c { m | 1 << i } else { m });
+        let seed = next_seed(&state);
+        state.say("editing the body parts…");
+        state.request(
+            Request::EditParts {
+                tokens: take.motion.tokens.clone(),
+                text: text.clone(),
+                parts: names,
+                seed,
+            },
+            Pending::Edit(Edit {
+                kind: EditKind::BodyParts,
+                text,
+                from_frame: 0,
+                to_frame: take.frames() as u32,
+                parts: mask,
+                seed,
+            }),
+        );
+    };
+    let regenerate = move |index: usize| {
+        let Some(take) = state.take() else { return };
+        let Some(segment) = take.segments.get(index).cloned() else {
+            return;
+        };
+        let seed = next_seed(&state);
+        state.say("regenerating the segment…");
+        state.request(
+            Request::InBetween {
+                tokens: take.motion.tokens.clone(),
+                text: segment.text.clone(),
+                from: segment.from,
+                to: segment.to,
+                seed,
+            },
+            Pending::Edit(Edit {
+                kind: EditKind::Regenerate,
+                text: segment.text,
+                from_frame: segment.from as u32,
+                to_frame: segment.to as u32,
+                parts: 0,
+                seed,
+            }),
+        );
+    };
+    let step = move |undo: bool| {
+        state.history.update(|h| {
+            if undo {
+                h.undo();
+            } else {
+                h.redo();
+            }
+        });
+        state.frame.set(0.0);
+        if let (Some(take), Some(model)) = (state.take(), state.model.get_untracked()) {
+            if let Some(id) = coma::share::model_id_bytes(&model.id) {
+                crate::browser::set_fragment(&coma::share::encode(&take.shared(id)));
+            }
+        }
+    };
+    let segments = move || {
+        state.history.with(|h| {
+            h.current().as_ref().map_or_else(Vec::new, |t| {
+                let total = t.frames().max(1) as f64;
+                t.segments
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| (i, s.text.clone(), (s.to - s.from) as f64 / total * 100.0))
+                    .collect()
+            })
+        })
+    };
+    view! {
+        <div class="panel timeline">
+            <div class="segments" aria-label="Segments">
+                {move || {
+                    segments()
+                        .into_iter()
+                        .map(|(i, text, width)| {
+                            let title = text.clone();
+                            view! {
+                                <div class="segment" style=format!("width: {width:.2}%") title=title>
+                                    <span>{text}</span>
+                                    <button
+                                        class="small"
+                                        on:click=move |_| regenerate(i)
+                                        disabled=move || state.busy()
+                                    >
+                                        "Regenerate"
+                                    </button>
+                                </div>
+                            }
+                        })
+                        .collect_view()
+                }}
+                <div
+                    class="playhead"
+                    style=move || {
+                        format!(
+                            "left: {:.2}%",
+                            state.frame.get() / frames().max(1) as f64 * 100.0,
+                        )
+                    }
+                ></div>
+            </div>
+            <div class="row">
+                <label>
+                    "From "
+                    <input
+                        type="number"
+                        min="0"
+                        step="0.2"
+                        prop:value=move || from.get().to_string()
+                        on:change=move |ev| {
+                            if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                                from.set(v.max(0.0));
+                            }
+                        }
+                    />
+                </label>
+                <label>
+                    "to "
+                    <input
+                        type="number"
+                        min="0"
+                        step="0.2"
+                        prop:value=move || to.get().to_string()
+                        on:change=move |ev| {
+                            if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                                to.set(v.max(0.0));
+                            }
+                        }
+                    />
+                    " s"
+                </label>
+                {BodyPart::ALL
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| {
+                        view! {
+                            <label class="part">
+                                <input
+                                    type="checkbox"
+                                    prop:checked=move || parts.get()[i]
+                                    on:change=move |ev| {
+                                        let on = event_target_checked(&ev);
+                                        parts.update(|ps| ps[i] = on);
+                                    }
+                                />
+                                {p.name()}
+                            </label>
+                        }
+                    })
+                    .collect_view()}
+            </div>
+            <div class="row">
+                <input
+                    id="instruction"
+                    type="text"
+                    placeholder="Instruction, e.g. raise the right arm higher"
+                    prop:value=move || instruction.get()
+                    on:input=move |ev| instruction.set(event_target_value(&ev))
+                />
+                <button on:click=edit_range disabled=move || state.busy() || !has_take()>
+                    "Edit range"
+                </button>
+                <button on:click=edit_parts disabled=move || state.busy() || !has_take()>
+                    "Edit parts"
+                </button>
+                <button
+                    id="undo"
+                    on:click=move |_| step(true)
+                    disabled=move || state.busy() || !state.history.with(|h| h.can_undo())
+                >
+                    "Undo"
+                </button>
+                <button
+                    id="redo"
+                    on:click=move |_| step(false)
+                    disabled=move || state.busy() || !state.history.with(|h| h.can_redo())
+                >
+                    "Redo"
+                </button>
+            </div>
+        </div>
+    }
+}
