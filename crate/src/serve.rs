@@ -44,17 +44,34 @@ fn respond(stream: &mut TcpStream, root: &Path) -> std::io::Result<()> {
     let mut reader = BufReader::new(stream.try_clone()?);
     let mut request = String::new();
     reader.read_line(&mut request)?;
-    // Drain the headers; we serve GET and HEAD only and need none of them.
+    // Of the headers only If-None-Match matters: it lets the browser keep the weights in its
+    // cache and ask only whether they changed.
     let mut line = String::new();
+    let mut if_none_match = None;
     while reader.read_line(&mut line)? > 2 {
+        if let Some((name, value)) = line.split_once(':') {
+            if name.eq_ignore_ascii_case("if-none-match") {
+                if_none_match = Some(value.trim().to_string());
+            }
+        }
         line.clear();
     }
     let mut words = request.split_whitespace();
     let method = words.next().unwrap_or("");
     let target = words.next().unwrap_or("/");
+    let mut etag = None;
     let (status, mime, body) = match (method, resolve(root, target)) {
         ("GET" | "HEAD", Some(path)) => match std::fs::read(&path) {
-            Ok(bytes) => ("200 OK", mime_type(&path), bytes),
+            Ok(bytes) => {
+                let tag = entity_tag(&bytes);
+                let fresh = if_none_match.as_deref() == Some(tag.as_str());
+                etag = Some(tag);
+                if fresh {
+                    ("304 Not Modified", mime_type(&path), Vec::new())
+                } else {
+                    ("200 OK", mime_type(&path), bytes)
+                }
+            }
             Err(_) => (
                 "404 Not Found",
                 "text/plain; charset=utf-8",
@@ -72,15 +89,26 @@ fn respond(stream: &mut TcpStream, root: &Path) -> std::io::Result<()> {
             b"method not allowed\n".to_vec(),
         ),
     };
+    let etag = etag.map_or(String::new(), |t| format!("ETag: {t}\r\n"));
     write!(
         stream,
-        "HTTP/1.1 {status}\r\nContent-Type: {mime}\r\nContent-Length: {}\r\nCache-Control: no-cache\r\nConnection: close\r\n\r\n",
+        "HTTP/1.1 {status}\r\nContent-Type: {mime}\r\nContent-Length: {}\r\nCache-Control: no-cache\r\n{etag}Connection: close\r\n\r\n",
         body.len()
     )?;
     if method != "HEAD" {
         stream.write_all(&body)?;
     }
     stream.flush()
+}
+
+/// A strong entity tag of a file's contents (FNV-1a of the bytes and their length).
+fn entity_tag(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("\"{:x}-{h:016x}\"", bytes.len())
 }
 
 /// Serves `root` on `127.0.0.1:port` until the process is stopped.
@@ -114,6 +142,41 @@ mod tests {
         );
         assert_eq!(resolve(root, "/../etc/passwd"), None);
         assert_eq!(resolve(root, "/a/../../b"), None);
+    }
+
+    #[test]
+    fn a_cached_file_is_not_sent_again() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("w.bpk"), b"weights").unwrap();
+        let listener = TcpListener::bind(("127.0.0.1", 0)).unwrap();
+        let port = listener.local_addr().unwrap().port();
+        let root = dir.path().to_path_buf();
+        std::thread::spawn(move || {
+            for stream in listener.incoming().take(2) {
+                let _ = respond(&mut stream.unwrap(), &root);
+            }
+        });
+        let get = |extra: &str| {
+            use std::io::Read;
+            let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
+            write!(s, "GET /w.bpk HTTP/1.1\r\nHost: x\r\n{extra}\r\n").unwrap();
+            let mut out = String::new();
+            s.read_to_string(&mut out).unwrap();
+            out
+        };
+        let first = get("");
+        assert!(
+            first.starts_with("HTTP/1.1 200") && first.ends_with("weights"),
+            "{first}"
+        );
+        let tag = first
+            .lines()
+            .find_map(|l| l.strip_prefix("ETag: "))
+            .unwrap()
+            .to_string();
+        let again = get(&format!("If-None-Match: {tag}\r\n"));
+        assert!(again.starts_with("HTTP/1.1 304"), "{again}");
+        assert!(again.ends_with("\r\n\r\n"), "no body: {again}");
     }
 
     #[test]

@@ -240,8 +240,8 @@ mod tests {
     fn a_planted_foot_does_not_skate_and_a_sliding_one_does() {
         let mut poses = vec![[[0.0; 3]; 22]; 11];
         for (t, p) in poses.iter_mut().enumerate() {
-            for j in 0..22 {
-                p[j][1] = 0.5;
+            for j in p.iter_mut() {
+                j[1] = 0.5;
             }
             // Left foot planted, right foot lifted and swinging forward.
             p[joint::L_ANKLE] = [0.1, 0.02, 0.0];

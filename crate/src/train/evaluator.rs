@@ -58,10 +58,7 @@ pub struct CaptionedMotions {
 
 impl CaptionedMotions {
     /// Embeds every distinct caption of `set` once with `embed`.
-    pub fn build(
-        set: &MotionSet,
-        embed: &dyn Fn(&[&str]) -> Result<Vec<[f32; TEXT_DIM]>>,
-    ) -> Result<CaptionedMotions> {
+    pub fn build(set: &MotionSet, embed: super::tokens::TextEmbedder) -> Result<CaptionedMotions> {
         let mut index: HashMap<&str, usize> = HashMap::new();
         let mut texts: Vec<&str> = Vec::new();
         let mut captions = Vec::with_capacity(set.items.len());

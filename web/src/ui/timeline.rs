@@ -38,7 +38,8 @@ pub fn Timeline() -> impl IntoView {
             return state.fail("Type an instruction for the edit first.");
         }
         let (a, b) = (from.get_untracked(), to.get_untracked());
-        if !(a < b) {
+        // NaN or a backward range: nothing to edit.
+        if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
             return state.fail("The range must start before it ends.");
         }
         let (a, b) = ((a * FPS) as usize, (b * FPS).ceil() as usize);
