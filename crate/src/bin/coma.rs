@@ -631,11 +631,11 @@ fn evaluate(
     if let Some(generator) = &spam {
         use coma::eval::probes::{continuity, edit_locality, left_right};
         eprintln!("probes: left/right over {probe_seeds} seeds a prompt");
-        let lr = left_right(&generator, probe_seeds, 4.0);
+        let lr = left_right(generator, probe_seeds, 4.0);
         probes.left_right_rate = Some(lr.rate);
         probes.left_right = lr.prompts;
         let locality = edit_locality(
-            &generator,
+            generator,
             "a person walks forward",
             "the person waves the left hand above the head",
             0,
@@ -648,7 +648,7 @@ fn evaluate(
             .map(|i| coma::features::features_to_joints(&test.normalizer.denormalize(&i.features)))
             .collect();
         let join = continuity(
-            &generator,
+            generator,
             "a person walks forward",
             "a person bows",
             &reference,
