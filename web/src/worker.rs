@@ -12,18 +12,14 @@ use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{DedicatedWorkerGlobalScope, MessageEvent};
 
-/// The files of the default model, in the order they are fetched.
-pub const MODEL_FILES: [&str; 9] = [
-    "spam.json",
-    "vq.bpk",
-    "base.bpk",
-    "residual.bpk",
-    "mean.npy",
-    "std.npy",
-    "minilm-vocab.txt",
-    "minilm-words.i8",
-    "minilm.bpk",
-];
+/// The files of the default model, in the order they are fetched: SPAM's, then the sentence
+/// encoder's.
+fn model_files() -> Vec<&'static str> {
+    use coma::text::minilm::{MODEL_FILE, VOCAB_FILE, WORDS_FILE};
+    let mut files = coma::model::WEIGHT_FILES.to_vec();
+    files.extend([VOCAB_FILE, WORDS_FILE, MODEL_FILE]);
+    files
+}
 
 thread_local! {
     static MODEL: RefCell<Option<MotionModel>> = const { RefCell::new(None) };
@@ -82,13 +78,14 @@ async fn fetch(url: &str) -> Result<Vec<u8>, String> {
 async fn load(base: &str) -> Result<Reply, String> {
     let started = now();
     let base = base.trim_end_matches('/');
-    let mut files = Vec::with_capacity(MODEL_FILES.len());
+    let names = model_files();
+    let mut files = Vec::with_capacity(names.len());
     let mut bytes = 0u64;
-    for (i, name) in MODEL_FILES.iter().enumerate() {
+    for (i, name) in names.iter().enumerate() {
         post(&Reply::Progress {
             stage: format!("downloading the model: {name}"),
             done: i as u64,
-            total: MODEL_FILES.len() as u64,
+            total: names.len() as u64,
         });
         let data = fetch(&format!("{base}/{name}")).await?;
         bytes += data.len() as u64;
@@ -96,11 +93,11 @@ async fn load(base: &str) -> Result<Reply, String> {
     }
     post(&Reply::Progress {
         stage: "preparing the model".into(),
-        done: MODEL_FILES.len() as u64,
-        total: MODEL_FILES.len() as u64,
+        done: names.len() as u64,
+        total: names.len() as u64,
     });
     let text = |i: usize| {
-        std::str::from_utf8(&files[i]).map_err(|_| format!("{} is not UTF-8 text", MODEL_FILES[i]))
+        std::str::from_utf8(&files[i]).map_err(|_| format!("{} is not UTF-8 text", names[i]))
     };
     // The models run on the CPU backend: generation reads logits back synchronously, which
     // WebGPU in a browser cannot do.

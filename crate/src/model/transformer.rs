@@ -210,9 +210,12 @@ impl Backbone {
 }
 
 /// Logits `[B, 4, N, K]` of hidden states `[B, 4, N, W]` against per-part embedding tables
-/// (`[K + 2, W]` each; only the first `K` rows are codes).
+/// (`[K + 2, W]` each; only the first `K` rows are codes), scaled by 1/√W: unit-variance
+/// states against unit-variance codes would otherwise start with logits of spread √W and a
+/// loss many times ln K.
 fn tied_logits(h: Tensor<4>, tables: Vec<Tensor<2>>, k: usize) -> Tensor<4> {
     let [b, _, n, w] = h.dims();
+    let h = h / (w as f64).sqrt();
     let parts: Vec<Tensor<3>> = tables
         .into_iter()
         .enumerate()
