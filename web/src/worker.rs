@@ -87,7 +87,16 @@ async fn load(base: &str) -> Result<Reply, String> {
             done: i as u64,
             total: names.len() as u64,
         });
-        let data = fetch(&format!("{base}/{name}")).await?;
+        let data = fetch(&format!("{base}/{name}")).await.map_err(|e| {
+            if i == 0 {
+                format!(
+                    "The motion model is not on this server ({e}). Its default weights are still \
+                     being trained: see README.md and MODEL_CARD.md."
+                )
+            } else {
+                e
+            }
+        })?;
         bytes += data.len() as u64;
         files.push(data);
     }
