@@ -254,24 +254,22 @@ pub fn train_evaluator(
                 &format!("{done},{top3:.4}"),
             )?;
         }
-        let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
-        if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
-            run.save(&model, &optim)?;
-            run.plot("text–motion evaluator", 20)?;
-            progress(&format!("checkpoint at step {done}"));
-        }
-        if out_of_time {
-            progress("time limit reached; run the same command again to resume");
+        if run.end_step(
+            &model,
+            &optim,
+            super::run::StepLimits {
+                steps: config.steps,
+                checkpoint_minutes: config.checkpoint_minutes,
+                minutes: options.minutes,
+            },
+            "text–motion evaluator",
+            progress,
+        )? {
             break;
         }
     }
     if run.state.step >= config.steps {
-        let weights = options.run_dir.join("evaluator.bpk");
-        model
-            .valid()
-            .save_file(&weights)
-            .map_err(|e| anyhow::anyhow!("saving {}: {e:?}", weights.display()))?;
-        progress(&format!("finished: weights in {}", weights.display()));
+        run.save_weights(model.valid(), "evaluator.bpk", progress)?;
     }
     Ok(())
 }

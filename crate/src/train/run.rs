@@ -23,6 +23,15 @@ pub struct RunState {
     pub samples: u64,
 }
 
+/// When a loop checkpoints and stops: its total steps, minutes between checkpoints, and this
+/// session's time limit in minutes.
+#[derive(Clone, Copy, Debug)]
+pub struct StepLimits {
+    pub steps: usize,
+    pub checkpoint_minutes: f64,
+    pub minutes: Option<f64>,
+}
+
 /// A training run's folder and bookkeeping.
 pub struct Run {
     pub dir: PathBuf,
@@ -223,6 +232,45 @@ impl Run {
                 .map_err(|e| anyhow::anyhow!("saving the optimizer: {e:?}"))?;
             Ok(())
         })
+    }
+
+    /// What every loop does after a step: checkpoints (and redraws the plot titled `title`)
+    /// when one is due, at the last step, or when this session's minutes are up. Returns
+    /// true when the loop must stop for time.
+    pub fn end_step<M: burn::module::Module>(
+        &mut self,
+        model: &M,
+        optim: &burn::optim::ModuleOptimizer,
+        limits: StepLimits,
+        title: &str,
+        progress: &dyn Fn(&str),
+    ) -> Result<bool> {
+        let done = self.state.step;
+        let out_of_time = limits.minutes.is_some_and(|m| self.session_minutes() >= m);
+        if self.checkpoint_due(limits.checkpoint_minutes) || done == limits.steps || out_of_time {
+            self.save(model, optim)?;
+            self.plot(title, 20)?;
+            progress(&format!("checkpoint at step {done}"));
+        }
+        if out_of_time {
+            progress("time limit reached; run the same command again to resume");
+        }
+        Ok(out_of_time)
+    }
+
+    /// Saves a finished run's weights as `name` in the run folder.
+    pub fn save_weights<M: burn::module::Module>(
+        &self,
+        model: M,
+        name: &str,
+        progress: &dyn Fn(&str),
+    ) -> Result<()> {
+        let weights = self.dir.join(name);
+        model
+            .save_file(&weights)
+            .map_err(|e| anyhow::anyhow!("saving {}: {e:?}", weights.display()))?;
+        progress(&format!("finished: weights in {}", weights.display()));
+        Ok(())
     }
 
     /// Redraws `losses.png` from `log.csv`, one curve per column, averaged over windows of

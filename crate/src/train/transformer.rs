@@ -244,36 +244,30 @@ pub fn train_transformer(
         if done % config.log_every == 0 || done == config.steps {
             progress(&run.progress_line(config.steps, done as f64 / epoch_steps));
         }
-        let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
-        if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
-            run.save(&model, &optim)?;
-            run.plot(
-                if kind == Kind::Base {
-                    "base transformer"
-                } else {
-                    "residual transformer"
-                },
-                20,
-            )?;
-            progress(&format!("checkpoint at step {done}"));
-        }
-        if out_of_time {
-            progress("time limit reached; run the same command again to resume");
+        let title = if kind == Kind::Base {
+            "base transformer"
+        } else {
+            "residual transformer"
+        };
+        if run.end_step(
+            &model,
+            &optim,
+            super::run::StepLimits {
+                steps: config.steps,
+                checkpoint_minutes: config.checkpoint_minutes,
+                minutes: options.minutes,
+            },
+            title,
+            progress,
+        )? {
             break;
         }
     }
     if run.state.step >= config.steps {
-        let weights = options.run_dir.join(if kind == Kind::Base {
-            "base.bpk"
-        } else {
-            "residual.bpk"
-        });
         match model.valid() {
-            Model::Base(m) => m.save_file(&weights),
-            Model::Residual(m) => m.save_file(&weights),
-        }
-        .map_err(|e| anyhow::anyhow!("saving {}: {e:?}", weights.display()))?;
-        progress(&format!("finished: weights in {}", weights.display()));
+            Model::Base(m) => run.save_weights(m, "base.bpk", progress),
+            Model::Residual(m) => run.save_weights(m, "residual.bpk", progress),
+        }?;
     }
     Ok(())
 }

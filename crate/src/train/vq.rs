@@ -181,24 +181,22 @@ pub fn train_vq(
                 &format!("{done},{:.3},{:.3}", e.root_aligned_mm, e.global_mm),
             )?;
         }
-        let out_of_time = options.minutes.is_some_and(|m| run.session_minutes() >= m);
-        if run.checkpoint_due(config.checkpoint_minutes) || done == config.steps || out_of_time {
-            run.save(&model, &optim)?;
-            run.plot("VQ-VAE training", 20)?;
-            progress(&format!("checkpoint at step {done}"));
-        }
-        if out_of_time {
-            progress("time limit reached; run the same command again to resume");
+        if run.end_step(
+            &model,
+            &optim,
+            super::run::StepLimits {
+                steps: config.steps,
+                checkpoint_minutes: config.checkpoint_minutes,
+                minutes: options.minutes,
+            },
+            "VQ-VAE training",
+            progress,
+        )? {
             break;
         }
     }
     if run.state.step >= config.steps {
-        let weights = options.run_dir.join("vq.bpk");
-        model
-            .valid()
-            .save_file(&weights)
-            .map_err(|e| anyhow::anyhow!("saving {}: {e:?}", weights.display()))?;
-        progress(&format!("finished: weights in {}", weights.display()));
+        run.save_weights(model.valid(), "vq.bpk", progress)?;
     }
     Ok(())
 }
