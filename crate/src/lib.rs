@@ -3,6 +3,7 @@
 //! Motions are 22-joint SMPL skeletons at 20 fps, Y up, metres, starting at the origin facing
 //! +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
 
+pub mod agents;
 pub mod bench;
 pub mod bvh;
 pub mod dataset;
@@ -20,3 +21,4 @@ pub mod share;
 pub mod skeleton;
 pub mod text;
 pub mod train;
+pub mod trajectory;

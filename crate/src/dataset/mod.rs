@@ -25,7 +25,7 @@ use crate::posecodes;
 use crate::skeleton::{self, Offsets, Pose};
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -120,8 +120,8 @@ pub struct DatasetSummary {
     pub items: Vec<ItemRecord>,
 }
 
-/// The words and labels a planner may use.
-#[derive(Clone, Debug, Serialize)]
+/// The words and labels a planner may use (shipped with the weights as `vocabulary.json`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Vocabulary {
     /// Action labels with their item counts.
     pub actions: BTreeMap<String, usize>,

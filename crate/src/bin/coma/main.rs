@@ -6,6 +6,8 @@ use coma::motion_file::{read_motion, write_motion};
 use coma::render::{FilmstripOptions, View};
 use std::path::PathBuf;
 
+mod agents;
+
 #[derive(Parser)]
 #[command(
     name = "coma",
@@ -84,6 +86,12 @@ enum Command {
         #[command(flatten)]
         model: ModelArgs,
     },
+    /// Plan a prompt (segments, base motions, part edits, paths) without generating.
+    Plan(agents::PlanArgs),
+    /// The whole CoMA loop: plan, generate, edit, review, blend and lay the paths.
+    Run(agents::RunArgs),
+    /// Draw the root path a phrase or an expression curve asks for, as a PNG.
+    Traj(agents::TrajArgs),
     /// Edit a saved motion (.npy features): regenerate a time range or some body parts.
     Edit {
         /// Motion to edit (.npy features from `coma generate` or the dataset).
@@ -111,7 +119,7 @@ enum Command {
     },
     /// Assemble trained runs into a model folder (the default model lives in static/models).
     Export {
-        /// What to export: the three SPAM networks, or the evaluator.
+        /// What to export: the three SPAM networks, the evaluator or the vocabulary.
         #[arg(value_enum, default_value_t = ExportWhat::Spam)]
         what: ExportWhat,
         /// Evaluator run folder (with evaluator.bpk and config.json).
@@ -402,6 +410,9 @@ enum ExportWhat {
     /// SPAM with random weights at the default sizes (configs/spam.json), for tests of the
     /// plumbing before trained weights exist; never the default model.
     Random,
+    /// The words and action labels of the training captions (from the dataset's
+    /// dataset.json), which the planner is told to use.
+    Vocabulary,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -474,7 +485,7 @@ fn probe(command: ProbeCommand) -> Result<()> {
 }
 
 /// SPAM and the sentence encoder from a model folder, on the CPU.
-fn load_model(dir: &std::path::Path) -> Result<coma::model::MotionModel> {
+pub(crate) fn load_model(dir: &std::path::Path) -> Result<coma::model::MotionModel> {
     Ok(coma::model::MotionModel::load(
         dir,
         &burn::tensor::Device::flex(),
@@ -495,7 +506,7 @@ fn parse_parts(parts: &[String]) -> Result<Vec<(coma::skeleton::BodyPart, String
 }
 
 /// Writes the motion file and/or filmstrip of generated features.
-fn write_outputs(
+pub(crate) fn write_outputs(
     features: &[coma::features::FeatureFrame],
     out: Option<&std::path::Path>,
     png: Option<&std::path::Path>,
@@ -855,6 +866,9 @@ fn run(cli: Cli) -> Result<()> {
         Command::Train {
             command: TrainCommand::Res(args),
         } => train_transformer(coma::train::transformer::Kind::Residual, args)?,
+        Command::Plan(args) => agents::plan(args)?,
+        Command::Run(args) => agents::run(args)?,
+        Command::Traj(args) => agents::traj(args)?,
         Command::Generate {
             prompt,
             seconds,
@@ -1032,6 +1046,35 @@ fn run(cli: Cli) -> Result<()> {
             }
             coma::model::Spam::load(&out, &device)?;
             println!("wrote SPAM with random weights into {}", out.display());
+        }
+        Command::Export {
+            what: ExportWhat::Vocabulary,
+            data,
+            out,
+            ..
+        } => {
+            let path = data.join("dataset.json");
+            let summary: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(&path)
+                    .with_context(|| format!("cannot read {}", path.display()))?,
+            )?;
+            let mut vocabulary = summary["vocabulary"].clone();
+            anyhow::ensure!(
+                vocabulary["words"].is_array(),
+                "{} has no vocabulary (rebuild it with `coma data build`)",
+                path.display()
+            );
+            vocabulary["licence"] = summary["licence"].clone();
+            std::fs::create_dir_all(&out)?;
+            std::fs::write(
+                out.join("vocabulary.json"),
+                serde_json::to_string_pretty(&vocabulary)? + "\n",
+            )?;
+            println!(
+                "wrote {} words into {}",
+                vocabulary["words"].as_array().map_or(0, Vec::len),
+                out.join("vocabulary.json").display()
+            );
         }
         Command::Export {
             what: ExportWhat::Evaluator,

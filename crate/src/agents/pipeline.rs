@@ -1,0 +1,489 @@
+//! The whole CoMA loop for one plan: generate each segment's base motion, edit its body
+//! parts, review and correct it for up to K rounds, blend the segments, and lay the root on
+//! the requested paths.
+//!
+//! Everything a run decides is kept: the plan (with its paths), the seeds, every edit and
+//! review, and the final tokens, so a share link rebuilds the exact motion with
+//! [`motion_features`] and no LLM.
+
+use crate::agents::llm::{LlmClient, Transport};
+use crate::agents::plan::{Plan, Segment};
+use crate::agents::reviewer::{self, Review, Scorer};
+use crate::features::{features_to_joints, FeatureFrame, Features};
+use crate::model::edit::PartText;
+use crate::model::generate::MotionTokens;
+use crate::model::motion_model::{frames_for_seconds, sampling};
+use crate::model::vq::DOWNSAMPLE;
+use crate::model::MotionModel;
+use crate::share::{Edit, EditKind};
+use crate::skeleton::{BodyPart, Pose};
+use crate::trajectory::{self, circle_report, CircleReport, MapOptions, Shape, Trajectory};
+use serde::Serialize;
+
+/// Review rounds per segment by default (K in the design).
+pub const DEFAULT_ROUNDS: usize = 2;
+
+/// Token steps (of 4 frames) regenerated on each side of a join when segments are blended.
+pub const BLEND_OVERLAP_STEPS: usize = 2;
+
+/// How a run samples and reviews.
+#[derive(Clone, Copy, Debug)]
+pub struct RunOptions {
+    /// Review rounds per segment (0 turns the reviewer off).
+    pub rounds: usize,
+    /// Seed of the whole run; each segment, edit and round derives its own from it.
+    pub seed: u64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            rounds: DEFAULT_ROUNDS,
+            seed: 0,
+        }
+    }
+}
+
+/// A step of a run, reported as it ends (the page shows each).
+#[derive(Clone, Debug)]
+pub enum RunEvent<'a> {
+    /// Segment `index`'s base motion exists.
+    Generated { index: usize, segment: &'a Segment },
+    /// Segment `index` had `part`s regenerated from `text`.
+    Edited {
+        index: usize,
+        parts: &'a [BodyPart],
+        text: &'a str,
+    },
+    /// A review round of segment `index` ended; `accepted` says whether its corrections were
+    /// kept.
+    Reviewed {
+        index: usize,
+        round: usize,
+        review: &'a Review,
+        accepted: bool,
+    },
+    /// The segments are joined.
+    Blended,
+}
+
+/// One review round as it was decided.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReviewRound {
+    pub review: Review,
+    /// The corrections were applied and kept (the evaluator did not score the result lower).
+    pub accepted: bool,
+    /// The segment's 0–100 similarity with its text after the round, where an evaluator
+    /// was at hand.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub score: Option<f64>,
+}
+
+/// What happened to one segment.
+#[derive(Clone, Debug, Serialize)]
+pub struct SegmentRun {
+    /// Frames (20 fps) of the segment before blending.
+    pub frames: usize,
+    /// The evaluator's similarity of the segment's text with its motion before review.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub score_before: Option<f64>,
+    /// The same after the last review round.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub score_after: Option<f64>,
+    pub rounds: Vec<ReviewRound>,
+    #[serde(skip)]
+    pub tokens: MotionTokens,
+}
+
+/// A finished run.
+#[derive(Clone, Debug, Serialize)]
+pub struct Run {
+    pub plan: Plan,
+    pub segments: Vec<SegmentRun>,
+    pub seed: u64,
+    /// Every step, as a share link records it.
+    #[serde(skip)]
+    pub history: Vec<Edit>,
+    /// The blended motion's tokens `[part][layer][step]`.
+    #[serde(skip)]
+    pub tokens: MotionTokens,
+    /// Notes of the reviewer (a judge that failed, a review skipped).
+    pub notes: Vec<String>,
+}
+
+fn part_bits(parts: &[BodyPart]) -> u8 {
+    parts
+        .iter()
+        .map(|p| 1u8 << BodyPart::ALL.iter().position(|q| q == p).unwrap_or(0))
+        .fold(0, |a, b| a | b)
+}
+
+/// Seed of step `k` of segment `index`: distinct for every sampling of the run.
+fn seed_of(run_seed: u64, index: usize, k: u64) -> u64 {
+    run_seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(index as u64 * 1000 + k)
+}
+
+/// The parts that share each instruction, so parts asked the same thing change together.
+fn grouped_edits(segment: &Segment) -> Vec<(String, Vec<BodyPart>)> {
+    let mut groups: Vec<(String, Vec<BodyPart>)> = Vec::new();
+    for (part, text) in segment.parts.edits() {
+        match groups.iter_mut().find(|(t, _)| *t == text) {
+            Some((_, parts)) => parts.push(part),
+            None => groups.push((text, vec![part])),
+        }
+    }
+    groups
+}
+
+/// Runs the loop over `plan`. `scorer` (the evaluator) judges without an LLM and keeps a
+/// correction only when it does not lower the score; `llm` judges when given.
+pub async fn run<T: Transport>(
+    model: &MotionModel,
+    scorer: Option<&Scorer<'_>>,
+    llm: Option<&LlmClient<T>>,
+    plan: Plan,
+    options: RunOptions,
+    progress: &mut dyn FnMut(RunEvent),
+) -> Run {
+    let mut history = Vec::new();
+    let mut segments = Vec::new();
+    let mut notes = Vec::new();
+    if options.rounds > 0 && scorer.is_none() && llm.is_none() {
+        notes.push("no evaluator and no LLM: the segments were not reviewed".into());
+    }
+    let mut start_frame = 0u32;
+    for (index, segment) in plan.segments.iter().enumerate() {
+        let frames = frames_for_seconds(segment.seconds);
+        let seed = seed_of(options.seed, index, 0);
+        let mut tokens = model.generate(&segment.base, &[], frames, seed);
+        let frames = tokens[0][0].len() * DOWNSAMPLE;
+        let range = (start_frame, start_frame + frames as u32);
+        history.push(Edit {
+            kind: EditKind::Generate,
+            text: segment.base.clone(),
+            from_frame: range.0,
+            to_frame: range.1,
+            parts: 0,
+            seed,
+        });
+        progress(RunEvent::Generated { index, segment });
+        for (k, (text, parts)) in grouped_edits(segment).into_iter().enumerate() {
+            let seed = seed_of(options.seed, index, 1 + k as u64);
+            tokens = model.edit_parts(&tokens, &text, &parts, &segment.base, seed);
+            history.push(Edit {
+                kind: EditKind::BodyParts,
+                text: text.clone(),
+                from_frame: range.0,
+                to_frame: range.1,
+                parts: part_bits(&parts),
+                seed,
+            });
+            progress(RunEvent::Edited {
+                index,
+                parts: &parts,
+                text: &text,
+            });
+        }
+        let score = |tokens: &MotionTokens| {
+            scorer.map(|s| s.segment_score(segment, &model.spam.decode(tokens)))
+        };
+        let score_before = score(&tokens);
+        let mut current = score_before;
+        let mut rounds = Vec::new();
+        for round in 0..options.rounds {
+            let normalized = model.spam.decode(&tokens);
+            let poses = features_to_joints(&model.normalizer.denormalize(&normalized));
+            let mut review = match scorer {
+                Some(s) => reviewer::judge_offline(segment, &poses, &normalized, s),
+                None => Review {
+                    description: reviewer::describe(&poses),
+                    scores: Vec::new(),
+                    corrections: Vec::new(),
+                    judge: reviewer::JudgeKind::Evaluator,
+                    note: None,
+                },
+            };
+            if let Some(client) = llm {
+                review = reviewer::judge_llm(client, segment, review).await;
+            } else if scorer.is_none() {
+                break;
+            }
+            if let Some(note) = &review.note {
+                notes.push(format!(
+                    "segment {}, round {}: {note}",
+                    index + 1,
+                    round + 1
+                ));
+            }
+            if review.corrections.is_empty() {
+                progress(RunEvent::Reviewed {
+                    index,
+                    round,
+                    review: &review,
+                    accepted: false,
+                });
+                rounds.push(ReviewRound {
+                    review,
+                    accepted: false,
+                    score: current,
+                });
+                break;
+            }
+            let mut candidate = tokens.clone();
+            let mut edits = Vec::new();
+            for (k, c) in review.corrections.iter().enumerate() {
+                let seed = seed_of(options.seed, index, 100 + 10 * round as u64 + k as u64);
+                candidate = model.edit_parts(
+                    &candidate,
+                    &c.instruction,
+                    c.region.parts(),
+                    &segment.base,
+                    seed,
+                );
+                edits.push(Edit {
+                    kind: EditKind::BodyParts,
+                    text: c.instruction.clone(),
+                    from_frame: range.0,
+                    to_frame: range.1,
+                    parts: part_bits(c.region.parts()),
+                    seed,
+                });
+            }
+            let after = score(&candidate);
+            let accepted = match (current, after) {
+                (Some(before), Some(after)) => after >= before,
+                _ => true,
+            };
+            if accepted {
+                tokens = candidate;
+                current = after;
+                history.extend(edits);
+            }
+            progress(RunEvent::Reviewed {
+                index,
+                round,
+                review: &review,
+                accepted,
+            });
+            rounds.push(ReviewRound {
+                review,
+                accepted,
+                score: current,
+            });
+        }
+        segments.push(SegmentRun {
+            frames,
+            score_before,
+            score_after: current,
+            rounds,
+            tokens,
+        });
+        start_frame = range.1;
+    }
+    let tokens = blend(model, &plan, &segments, options.seed, &mut history);
+    if plan.segments.len() > 1 {
+        progress(RunEvent::Blended);
+    }
+    Run {
+        plan,
+        segments,
+        seed: options.seed,
+        history,
+        tokens,
+        notes,
+    }
+}
+
+/// The condition a segment's motion was made with, for the transition into or out of it.
+fn condition(model: &MotionModel, segment: &Segment) -> PartText {
+    model.condition(&segment.base, &segment.parts.edits())
+}
+
+fn blend(
+    model: &MotionModel,
+    plan: &Plan,
+    segments: &[SegmentRun],
+    seed: u64,
+    history: &mut Vec<Edit>,
+) -> MotionTokens {
+    let mut joined = segments[0].tokens.clone();
+    let mut end = segments[0].frames as u32;
+    for (i, next) in segments.iter().enumerate().skip(1) {
+        let seed = seed_of(seed, i, 900);
+        let a = condition(model, &plan.segments[i - 1]);
+        let b = condition(model, &plan.segments[i]);
+        joined = model.spam.blend(
+            &joined,
+            &next.tokens,
+            &a,
+            &b,
+            BLEND_OVERLAP_STEPS,
+            &sampling(seed),
+        );
+        let overlap = (BLEND_OVERLAP_STEPS * DOWNSAMPLE) as u32;
+        history.push(Edit {
+            kind: EditKind::Blend,
+            text: String::new(),
+            from_frame: end.saturating_sub(overlap),
+            to_frame: end + overlap,
+            parts: 0b1111,
+            seed,
+        });
+        end += next.frames as u32;
+    }
+    joined
+}
+
+/// Feature rows of each segment in the blended motion: blending keeps every segment's
+/// length, so segment `i` starts where the ones before it end.
+pub fn segment_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range<usize>> {
+    let total = tokens[0][0].len() * DOWNSAMPLE;
+    let mut start = 0;
+    plan.segments
+        .iter()
+        .map(|s| {
+            let frames = frames_for_seconds(s.seconds).div_ceil(DOWNSAMPLE) * DOWNSAMPLE;
+            let r = start.min(total)..(start + frames).min(total);
+            start += frames;
+            r
+        })
+        .collect()
+}
+
+/// The features (not normalised, 20 fps) of a run's tokens with every segment's path laid on
+/// the root. A link rebuilds the motion with this and its plan alone.
+pub fn motion_features(
+    model: &MotionModel,
+    plan: &Plan,
+    tokens: &MotionTokens,
+) -> (Features, Vec<String>) {
+    let mut features = model.features(tokens);
+    let mut notes = Vec::new();
+    for (segment, range) in plan.segments.iter().zip(segment_ranges(plan, tokens)) {
+        if let Some(path) = &segment.trajectory {
+            match trajectory::apply(&features[range.clone()], path, &MapOptions::default()) {
+                Ok((walked, _)) => features[range].copy_from_slice(&walked),
+                Err(e) => notes.push(format!(
+                    "the path of \"{}\" was not applied: {e}",
+                    segment.text
+                )),
+            }
+        }
+    }
+    (features, notes)
+}
+
+/// Joint positions (metres, 20 fps) of a run.
+pub fn motion_joints(model: &MotionModel, plan: &Plan, tokens: &MotionTokens) -> Vec<Pose> {
+    features_to_joints(&motion_features(model, plan, tokens).0)
+}
+
+/// How well a segment walked the path it asked for.
+#[derive(Clone, Debug, Serialize)]
+pub struct PathReport {
+    /// Segment number, from 1.
+    pub segment: usize,
+    /// The path asked for ("a circle, clockwise").
+    pub path: String,
+    /// For circles: closure, distance to the circle, turning direction.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub circle: Option<CircleReport>,
+}
+
+impl PathReport {
+    /// One line for the terminal.
+    pub fn summary(&self) -> String {
+        match &self.circle {
+            Some(c) => {
+                format!(
+                "segment {}: {}: turned {:.0}° {}, closure error {:.2} m, mean distance to the \
+                 circle {:.2} m (radius {:.2} m)",
+                self.segment,
+                self.path,
+                c.total_turn_deg,
+                if c.turned_clockwise { "clockwise" } else { "counter-clockwise" },
+                c.closure_error_m,
+                c.mean_radius_error_m,
+                c.radius_m
+            )
+            }
+            None => format!("segment {}: walked {}", self.segment, self.path),
+        }
+    }
+}
+
+/// The paths of a run's segments as walked in `features` (from [`motion_features`]).
+pub fn path_reports(
+    plan: &Plan,
+    tokens: &MotionTokens,
+    features: &[FeatureFrame],
+) -> Vec<PathReport> {
+    plan.segments
+        .iter()
+        .zip(segment_ranges(plan, tokens))
+        .enumerate()
+        .filter_map(|(i, (segment, range))| {
+            let path = segment.trajectory.as_ref()?;
+            let circle = match path {
+                Trajectory::Shape {
+                    shape: Shape::Circle(side),
+                } => Some(circle_report(
+                    &trajectory::root_path(&features[range]),
+                    side.is_clockwise(),
+                )),
+                _ => None,
+            };
+            Some(PathReport {
+                segment: i + 1,
+                path: path.describe(),
+                circle,
+            })
+        })
+        .collect()
+}
+
+/// One line for a progress log.
+pub fn describe_event(event: &RunEvent) -> String {
+    match event {
+        RunEvent::Generated { index, segment } => {
+            format!("segment {}: generated \"{}\"", index + 1, segment.base)
+        }
+        RunEvent::Edited { index, parts, text } => {
+            let names: Vec<&str> = parts.iter().map(|p| p.name()).collect();
+            format!(
+                "segment {}: {} ← \"{text}\"",
+                index + 1,
+                names.join(" and ")
+            )
+        }
+        RunEvent::Reviewed {
+            index,
+            round,
+            review,
+            accepted,
+        } => {
+            let what = if review.corrections.is_empty() {
+                "nothing to correct".to_string()
+            } else {
+                let fixes: Vec<String> = review
+                    .corrections
+                    .iter()
+                    .map(|c| format!("{:?} ← \"{}\"", c.region, c.instruction))
+                    .collect();
+                format!(
+                    "{} ({})",
+                    fixes.join(", "),
+                    if *accepted {
+                        "kept"
+                    } else {
+                        "scored lower, dropped"
+                    }
+                )
+            };
+            format!("segment {}, review {}: {what}", index + 1, round + 1)
+        }
+        RunEvent::Blended => "segments blended".to_string(),
+    }
+}

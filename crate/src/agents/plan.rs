@@ -1,0 +1,152 @@
+//! What the planner hands to the generator: a prompt cut into consecutive segments, each with
+//! a whole-body motion, instructions per body part and an optional root path.
+
+use crate::skeleton::BodyPart;
+use crate::trajectory::Trajectory;
+use serde::{Deserialize, Serialize};
+
+/// Shortest segment the model makes well, in seconds (40 frames at 20 fps).
+pub const MIN_SEGMENT_SECONDS: f64 = 2.0;
+/// Longest segment one generation makes, in seconds (196 frames at 20 fps).
+pub const MAX_SEGMENT_SECONDS: f64 = 9.8;
+/// Most segments in one plan.
+pub const MAX_SEGMENTS: usize = 4;
+/// Longest text the planner keeps for one prompt, segment or instruction, in characters:
+/// MiniLM reads 256 word pieces at most, and longer replies are a sign of a confused model.
+pub const MAX_TEXT_CHARS: usize = 300;
+
+/// One instruction per body part, in the words of the model's captions ("a person waves the
+/// left hand"); `None` where the part simply follows the segment's base motion.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PartEdits {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub left_arm: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub right_arm: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub left_leg: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub right_leg: Option<String>,
+}
+
+impl PartEdits {
+    /// The instruction of one part.
+    pub fn get(&self, part: BodyPart) -> Option<&str> {
+        match part {
+            BodyPart::LeftArm => self.left_arm.as_deref(),
+            BodyPart::RightArm => self.right_arm.as_deref(),
+            BodyPart::LeftLeg => self.left_leg.as_deref(),
+            BodyPart::RightLeg => self.right_leg.as_deref(),
+        }
+    }
+
+    /// Sets (or with `None` clears) one part's instruction.
+    pub fn set(&mut self, part: BodyPart, text: Option<String>) {
+        let slot = match part {
+            BodyPart::LeftArm => &mut self.left_arm,
+            BodyPart::RightArm => &mut self.right_arm,
+            BodyPart::LeftLeg => &mut self.left_leg,
+            BodyPart::RightLeg => &mut self.right_leg,
+        };
+        *slot = text;
+    }
+
+    /// The parts that have an instruction, in model order.
+    pub fn edits(&self) -> Vec<(BodyPart, String)> {
+        BodyPart::ALL
+            .iter()
+            .filter_map(|p| self.get(*p).map(|t| (*p, t.to_string())))
+            .collect()
+    }
+
+    /// True when no part has its own instruction.
+    pub fn is_empty(&self) -> bool {
+        self.edits().is_empty()
+    }
+}
+
+/// One temporally consecutive movement of the plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Segment {
+    /// The whole segment in one sentence ("a person walks forward while waving the left hand").
+    pub text: String,
+    /// Length in seconds at 20 fps, within [`MIN_SEGMENT_SECONDS`]..=[`MAX_SEGMENT_SECONDS`].
+    pub seconds: f64,
+    /// The whole-body motion generated first ("a person walks forward").
+    pub base: String,
+    /// The body-part edits applied to the base motion.
+    #[serde(default)]
+    pub parts: PartEdits,
+    /// The path the root follows on the ground, if the segment asks for one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trajectory: Option<Trajectory>,
+}
+
+/// Who made a plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum PlannerKind {
+    /// The deterministic built-in planner (no LLM).
+    Offline,
+    /// An LLM, named by its model id.
+    Llm { model: String },
+}
+
+/// A prompt turned into segments.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// What the user typed.
+    pub prompt: String,
+    /// The prompt in words the motion model knows.
+    pub rewritten: String,
+    /// One to [`MAX_SEGMENTS`] consecutive segments.
+    pub segments: Vec<Segment>,
+    pub planner: PlannerKind,
+    /// What the planner changed or dropped, and why (clamped durations, unknown words, an LLM
+    /// that failed and the fallback that took over).
+    #[serde(default)]
+    pub notes: Vec<String>,
+}
+
+impl Plan {
+    /// Total length in seconds, before blending shortens the joins.
+    pub fn seconds(&self) -> f64 {
+        self.segments.iter().map(|s| s.seconds).sum()
+    }
+}
+
+/// Clamps a duration into what one generation makes; `None` for a value that is not a
+/// number of seconds at all.
+pub fn clamp_seconds(seconds: f64) -> Option<f64> {
+    seconds
+        .is_finite()
+        .then(|| seconds.clamp(MIN_SEGMENT_SECONDS, MAX_SEGMENT_SECONDS))
+}
+
+/// A text fit for the motion model: printable, trimmed, single-spaced and at most
+/// [`MAX_TEXT_CHARS`] characters. Returns why not otherwise.
+pub fn clean_text(text: &str) -> Result<String, String> {
+    if text.chars().count() > MAX_TEXT_CHARS * 4 {
+        return Err(format!(
+            "a text of {} characters (at most {MAX_TEXT_CHARS})",
+            text.chars().count()
+        ));
+    }
+    if let Some(c) = text.chars().find(|c| c.is_control() && !c.is_whitespace()) {
+        return Err(format!(
+            "a control character (U+{:04X}) in a text",
+            c as u32
+        ));
+    }
+    let cleaned = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    if cleaned.is_empty() {
+        return Err("an empty text".into());
+    }
+    if cleaned.chars().count() > MAX_TEXT_CHARS {
+        return Err(format!(
+            "a text of {} characters (at most {MAX_TEXT_CHARS})",
+            cleaned.chars().count()
+        ));
+    }
+    Ok(cleaned)
+}

@@ -1,0 +1,435 @@
+//! The planner's three LLM steps: rewrite, segment, decompose.
+//!
+//! Each step sends one question with a JSON schema, parses and validates the reply, retries
+//! once with the validation error, and otherwise lets the built-in planner do that step (with
+//! a note in the plan). The reply is data: texts are cleaned and capped, durations clamped,
+//! paths checked by the sandboxed expression evaluator and never run as code.
+
+use super::offline::{self, Embedder};
+use crate::agents::llm::{
+    parse_json_content, LlmClient, LlmError, Message, ReplyFormat, Transport,
+};
+use crate::agents::plan::{
+    clamp_seconds, clean_text, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS,
+};
+use crate::dataset::Vocabulary;
+use crate::trajectory::{CurveSpec, Shape, Trajectory};
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+/// A step of the planner, reported as it finishes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlanEvent {
+    /// The prompt in the model's words.
+    Rewritten(String),
+    /// The segments' texts and durations in seconds.
+    Segmented(Vec<(String, f64)>),
+    /// Segment `index` has its base motion, part edits and path.
+    Decomposed(usize, Segment),
+}
+
+/// Plans `prompt` with an LLM, step by step, falling back to the built-in rules for any step
+/// the LLM fails. `progress` hears each step as it ends.
+pub async fn plan<T: Transport>(
+    client: &LlmClient<T>,
+    prompt: &str,
+    vocabulary: &Vocabulary,
+    embed: Option<Embedder<'_>>,
+    progress: &mut dyn FnMut(&PlanEvent),
+) -> Plan {
+    let mut notes = Vec::new();
+    let offline_plan = offline::plan(prompt, embed);
+    let context = vocabulary_brief(vocabulary);
+
+    // The text the later steps read: the LLM's rewrite, or the user's prompt itself when the
+    // rewrite failed (the built-in rules read the prompt better than their own rewrite).
+    let (rewritten, source) =
+        match ask::<RewriteReply, _>(client, rewrite_messages(&context, prompt), "rewrite")
+            .await
+            .and_then(|r| clean_text(&r.description).map_err(StepError::Invalid))
+        {
+            Ok(text) => (text.clone(), text),
+            Err(e) => {
+                notes.push(e.note("rewrite"));
+                (offline_plan.rewritten.clone(), prompt.to_string())
+            }
+        };
+    progress(&PlanEvent::Rewritten(rewritten.clone()));
+
+    let pieces = match ask::<SegmentReply, _>(client, segment_messages(&rewritten), "segment")
+        .await
+        .and_then(|r| r.validate().map_err(StepError::Invalid))
+    {
+        Ok(pieces) => pieces,
+        Err(e) => {
+            notes.push(e.note("segment"));
+            offline::plan(&source, embed)
+                .segments
+                .into_iter()
+                .map(|s| (s.text, s.seconds))
+                .collect()
+        }
+    };
+    progress(&PlanEvent::Segmented(pieces.clone()));
+
+    let mut segments = Vec::new();
+    for (index, (text, seconds)) in pieces.into_iter().enumerate() {
+        let segment = match ask::<DecomposeReply, _>(
+            client,
+            decompose_messages(&context, &text),
+            "decompose",
+        )
+        .await
+        .and_then(|r| r.validate(&text, seconds).map_err(StepError::Invalid))
+        {
+            Ok(segment) => segment,
+            Err(e) => {
+                notes.push(e.note(&format!("decompose (segment {})", index + 1)));
+                let mut s = offline::plan(&text, embed).segments.remove(0);
+                s.seconds = seconds;
+                s
+            }
+        };
+        progress(&PlanEvent::Decomposed(index, segment.clone()));
+        segments.push(segment);
+    }
+    Plan {
+        prompt: prompt.to_string(),
+        rewritten,
+        segments,
+        planner: PlannerKind::Llm {
+            model: client.config().model.clone(),
+        },
+        notes,
+    }
+}
+
+/// Why a step's reply was not used.
+#[derive(Debug)]
+enum StepError {
+    /// The request itself failed (network, key, server).
+    Llm(LlmError),
+    /// The reply did not parse or did not pass validation, even after one retry.
+    Invalid(String),
+}
+
+impl StepError {
+    fn note(&self, step: &str) -> String {
+        let why = match self {
+            StepError::Llm(e) => e.to_string(),
+            StepError::Invalid(e) => format!("its reply was unusable: {e}"),
+        };
+        format!("the LLM's {step} step failed ({why}); the built-in planner did that step")
+    }
+}
+
+/// One question, with one retry that quotes the reply's problem.
+async fn ask<R: for<'de> Deserialize<'de> + Schema, T: Transport>(
+    client: &LlmClient<T>,
+    mut messages: Vec<Message>,
+    name: &str,
+) -> Result<R, StepError> {
+    let format = ReplyFormat::JsonSchema {
+        name: format!("coma_{name}"),
+        schema: R::schema(),
+    };
+    for attempt in 0..2 {
+        let reply = client
+            .chat(&messages, &format)
+            .await
+            .map_err(StepError::Llm)?;
+        match parse_json_content::<R>(&reply.content).and_then(|r| r.check().map(|_| r)) {
+            Ok(r) => return Ok(r),
+            Err(e) if attempt == 0 => {
+                let quoted: String = reply.content.chars().take(2000).collect();
+                messages.push(Message::assistant(quoted));
+                messages.push(Message::user(format!(
+                    "That reply cannot be used: {e}. Answer again with only a JSON object that \
+                     follows the schema."
+                )));
+            }
+            Err(e) => return Err(StepError::Invalid(e)),
+        }
+    }
+    unreachable!("the loop returns on its second attempt")
+}
+
+/// A reply type with its JSON Schema and a first check of its shape.
+trait Schema {
+    fn schema() -> Value;
+    fn check(&self) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RewriteReply {
+    description: String,
+}
+
+impl Schema for RewriteReply {
+    fn schema() -> Value {
+        json!({
+            "type": "object",
+            "properties": {"description": {"type": "string", "maxLength": 600}},
+            "required": ["description"],
+            "additionalProperties": false
+        })
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SegmentReply {
+    segments: Vec<SegmentPiece>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SegmentPiece {
+    text: String,
+    seconds: f64,
+}
+
+impl Schema for SegmentReply {
+    fn schema() -> Value {
+        json!({
+            "type": "object",
+            "properties": {"segments": {
+                "type": "array", "minItems": 1, "maxItems": MAX_SEGMENTS,
+                "items": {
+                    "type": "object",
+                    "properties": {
+                        "text": {"type": "string", "maxLength": 300},
+                        "seconds": {"type": "number", "minimum": 2, "maximum": 9.8}
+                    },
+                    "required": ["text", "seconds"],
+                    "additionalProperties": false
+                }
+            }},
+            "required": ["segments"],
+            "additionalProperties": false
+        })
+    }
+
+    fn check(&self) -> Result<(), String> {
+        self.validate().map(|_| ())
+    }
+}
+
+impl SegmentReply {
+    fn validate(&self) -> Result<Vec<(String, f64)>, String> {
+        if self.segments.is_empty() || self.segments.len() > MAX_SEGMENTS {
+            return Err(format!(
+                "it has {} segments; give 1 to {MAX_SEGMENTS}",
+                self.segments.len()
+            ));
+        }
+        self.segments
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let seconds = clamp_seconds(s.seconds)
+                    .ok_or_else(|| format!("segment {} has no valid number of seconds", i + 1))?;
+                Ok((
+                    clean_text(&s.text).map_err(|e| format!("segment {}: {e}", i + 1))?,
+                    seconds,
+                ))
+            })
+            .collect()
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DecomposeReply {
+    base: String,
+    left_arm: Option<String>,
+    right_arm: Option<String>,
+    left_leg: Option<String>,
+    right_leg: Option<String>,
+    trajectory: Option<Value>,
+}
+
+impl Schema for DecomposeReply {
+    fn schema() -> Value {
+        let part = json!({"type": ["string", "null"], "maxLength": 300});
+        json!({
+            "type": "object",
+            "properties": {
+                "base": {"type": "string", "maxLength": 300},
+                "left_arm": part, "right_arm": part, "left_leg": part, "right_leg": part,
+                "trajectory": trajectory_schema()
+            },
+            "required": ["base", "left_arm", "right_arm", "left_leg", "right_leg", "trajectory"],
+            "additionalProperties": false
+        })
+    }
+}
+
+impl DecomposeReply {
+    fn validate(&self, text: &str, seconds: f64) -> Result<Segment, String> {
+        let part = |p: &Option<String>, name: &str| -> Result<Option<String>, String> {
+            match p.as_deref().map(str::trim) {
+                None | Some("") => Ok(None),
+                Some(t) if matches!(t.to_lowercase().as_str(), "none" | "null" | "n/a" | "-") => {
+                    Ok(None)
+                }
+                Some(t) => clean_text(t).map(Some).map_err(|e| format!("{name}: {e}")),
+            }
+        };
+        let trajectory = match &self.trajectory {
+            None | Some(Value::Null) => None,
+            Some(v) => Some(trajectory_from_reply(v).map_err(|e| format!("trajectory: {e}"))?),
+        };
+        Ok(Segment {
+            text: text.to_string(),
+            seconds,
+            base: clean_text(&self.base).map_err(|e| format!("base: {e}"))?,
+            parts: PartEdits {
+                left_arm: part(&self.left_arm, "left_arm")?,
+                right_arm: part(&self.right_arm, "right_arm")?,
+                left_leg: part(&self.left_leg, "left_leg")?,
+                right_leg: part(&self.right_leg, "right_leg")?,
+            },
+            trajectory,
+        })
+    }
+}
+
+/// The built-in shapes by their stable names ("circle_right" is clockwise).
+fn shape_names() -> Vec<String> {
+    Shape::ALL.iter().map(|s| s.name()).collect()
+}
+
+/// The two forms a path takes in a reply: a named shape, or a curve in `t`.
+fn trajectory_schema() -> Value {
+    json!({
+        "anyOf": [
+            {"type": "null"},
+            {
+                "type": "object",
+                "properties": {"shape": {"type": "string", "enum": shape_names()}},
+                "required": ["shape"],
+                "additionalProperties": false
+            },
+            {
+                "type": "object",
+                "properties": {
+                    "x": {"type": "string", "maxLength": crate::trajectory::expr::MAX_SOURCE_LEN},
+                    "z": {"type": "string", "maxLength": crate::trajectory::expr::MAX_SOURCE_LEN},
+                    "t0": {"type": "number"},
+                    "t1": {"type": "number"}
+                },
+                "required": ["x", "z", "t0", "t1"],
+                "additionalProperties": false
+            }
+        ]
+    })
+}
+
+/// A path from a reply, checked by the sandboxed evaluator: a shape name from the library,
+/// or formulas that parse within the sandbox's limits and make a walkable curve.
+fn trajectory_from_reply(value: &Value) -> Result<Trajectory, String> {
+    let object = value
+        .as_object()
+        .ok_or("expected an object with \"shape\", or with \"x\", \"z\", \"t0\" and \"t1\"")?;
+    let trajectory = if let Some(name) = object.get("shape") {
+        if object.len() != 1 {
+            return Err("a shape takes no other keys".into());
+        }
+        let name = name.as_str().ok_or("\"shape\" must be a string")?;
+        let shape = Shape::from_name(name)
+            .ok_or_else(|| format!("unknown shape (use one of {})", shape_names().join(", ")))?;
+        Trajectory::Shape { shape }
+    } else {
+        if let Some(k) = object
+            .keys()
+            .find(|k| !matches!(k.as_str(), "x" | "z" | "y" | "t0" | "t1"))
+        {
+            let k: String = k.chars().take(40).collect();
+            return Err(format!("unexpected key \"{k}\""));
+        }
+        let spec: CurveSpec = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
+        Trajectory::Curve(spec)
+    };
+    trajectory.validate().map_err(|e| e.to_string())?;
+    Ok(trajectory)
+}
+
+/// What the motion model knows, for the rewrite and decompose questions: its actions with an
+/// example caption each, its styles and its caption words.
+pub fn vocabulary_brief(vocabulary: &Vocabulary) -> String {
+    let actions: Vec<String> = vocabulary
+        .examples
+        .iter()
+        .map(|(action, example)| format!("- {action}: \"{example}\""))
+        .collect();
+    let styles: Vec<&str> = vocabulary.styles.keys().map(String::as_str).collect();
+    format!(
+        "Movements the motion model was trained on, each with an example caption:\n{}\n\
+         Styles it knows: {}.\nWords of its captions: {}.",
+        actions.join("\n"),
+        styles.join(", "),
+        vocabulary.words.join(" ")
+    )
+}
+
+fn rewrite_messages(context: &str, prompt: &str) -> Vec<Message> {
+    vec![
+        Message::system(format!(
+            "You prepare prompts for a text-to-motion model that animates one human skeleton \
+             (arms, legs, torso, and where the body goes on the ground). It only understands \
+             plain physical descriptions in the words of its training captions.\n\n{context}\n\n\
+             Rewrite the user's prompt as a concrete description of the body's movements, in \
+             time order, using the model's words where you can. Keep style words the model \
+             knows. Leave out what does not change the movement: places, names, reasons, \
+             emotions it has no style for. Describe named gestures by the movement itself (a \
+             military salute becomes raising the right hand to the forehead). Keep every \
+             movement, path and body part the prompt asks for. Reply in JSON: \
+             {{\"description\": \"...\"}}."
+        )),
+        Message::user(prompt.to_string()),
+    ]
+}
+
+fn segment_messages(description: &str) -> Vec<Message> {
+    vec![
+        Message::system(format!(
+            "Split a description of a human movement into 1 to {MAX_SEGMENTS} consecutive \
+             segments. Each segment is one complete movement that could be filmed alone; \
+             things done at the same time (walking while waving) stay in one segment, and a \
+             repeated whole-body action (bowing twice) is one segment per repetition. Give \
+             each segment a duration in seconds between 2 and 9.8 (a few steps of walking take \
+             about 4 s, a bow about 3 s, a wave about 3 s). Write each segment's text as a \
+             full sentence about \"a person\". Reply in JSON: {{\"segments\": [{{\"text\": \
+             \"...\", \"seconds\": 4}}]}}."
+        )),
+        Message::user(description.to_string()),
+    ]
+}
+
+fn decompose_messages(context: &str, segment: &str) -> Vec<Message> {
+    vec![
+        Message::system(format!(
+            "You turn one segment of a human movement into instructions for a motion model \
+             that first makes a whole-body motion and then re-animates single body parts.\n\n\
+             {context}\n\nGive: \"base\", the whole-body motion as one caption in the model's \
+             words (\"a person walks forward\"); for each of left_arm, right_arm, left_leg and \
+             right_leg, a caption of what that part does differently from the base (\"a person \
+             waves the left hand\"), or null when it just follows the base; and \"trajectory\", \
+             null unless the segment asks for a path on the ground. A path is either \
+             {{\"shape\": NAME}} with NAME one of {shapes}, or a curve {{\"x\": EXPR, \"z\": \
+             EXPR, \"t0\": NUMBER, \"t1\": NUMBER}} on the ground (z is forward, x is the \
+             person's left) where EXPR is arithmetic in t with + - * / ^, sin, cos, tan, abs, \
+             sqrt, exp, log, min, max, pi and if(cond, a, b). Reply in JSON with exactly these \
+             six keys.",
+            shapes = shape_names().join(", ")
+        )),
+        Message::user(segment.to_string()),
+    ]
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,218 @@
+use super::*;
+use crate::agents::llm::script_server::{ScriptServer, ScriptedReply};
+use crate::agents::llm::{block_on, Backoff, LlmConfig, UreqTransport};
+use std::time::Duration;
+
+const PROMPT: &str = "A person walks forward waving the left hand, then turns right and bows";
+
+fn vocabulary() -> Vocabulary {
+    serde_json::from_str(include_str!("../../../../../static/models/vocabulary.json")).unwrap()
+}
+
+fn client(server: &ScriptServer) -> LlmClient<UreqTransport> {
+    let mut config = LlmConfig::new(server.base_url(), "scripted").with_api_key("sk-test-secret");
+    config.max_retries = 1;
+    config.timeout = Duration::from_secs(5);
+    config.max_reply_bytes = 100 * 1024;
+    config.backoff = Backoff {
+        initial: Duration::from_millis(1),
+        max: Duration::from_millis(2),
+        retry_after_cap: Duration::from_millis(2),
+    };
+    LlmClient::native(config).unwrap()
+}
+
+fn good(step: &str) -> ScriptedReply {
+    ScriptedReply::completion(match step {
+        "rewrite" => {
+            r#"{"description": "a person walks forward waving the left hand, then walks and turns right, then bows"}"#
+        }
+        "segment" => {
+            r#"{"segments": [{"text": "a person walks forward waving the left hand", "seconds": 4.5}]}"#
+        }
+        _ => {
+            r#"{"base": "a person walks forward", "left_arm": "a person waves the left hand", "right_arm": null, "left_leg": null, "right_leg": null, "trajectory": null}"#
+        }
+    })
+}
+
+fn run(server: &ScriptServer) -> (Plan, Vec<PlanEvent>) {
+    let client = client(server);
+    let mut events = Vec::new();
+    let plan = block_on(plan(&client, PROMPT, &vocabulary(), None, &mut |e| {
+        events.push(e.clone())
+    }));
+    (plan, events)
+}
+
+fn assert_valid(plan: &Plan, context: &str) {
+    assert!(
+        (1..=MAX_SEGMENTS).contains(&plan.segments.len()),
+        "{context}: {plan:#?}"
+    );
+    for s in &plan.segments {
+        assert!((2.0..=9.8).contains(&s.seconds), "{context}: {}", s.seconds);
+        for t in std::iter::once(&s.base).chain(std::iter::once(&s.text)) {
+            assert!(
+                clean_text(t).as_deref() == Ok(t.as_str()),
+                "{context}: {t:?}"
+            );
+        }
+        for (_, t) in s.parts.edits() {
+            assert!(
+                clean_text(&t).as_deref() == Ok(t.as_str()),
+                "{context}: {t:?}"
+            );
+        }
+        if let Some(t) = &s.trajectory {
+            t.validate().unwrap_or_else(|e| panic!("{context}: {e}"));
+        }
+    }
+    assert!(!plan.rewritten.is_empty());
+}
+
+#[test]
+fn a_well_behaved_llm_plans_every_step() {
+    let server =
+        ScriptServer::start([good("rewrite"), good("segment"), good("decompose")]).unwrap();
+    let (plan, events) = run(&server);
+    assert!(plan.notes.is_empty(), "{:?}", plan.notes);
+    assert_eq!(
+        plan.planner,
+        PlannerKind::Llm {
+            model: "scripted".into()
+        }
+    );
+    assert_eq!(plan.segments.len(), 1);
+    assert_eq!(plan.segments[0].seconds, 4.5);
+    assert_eq!(
+        plan.segments[0].parts.left_arm.as_deref(),
+        Some("a person waves the left hand")
+    );
+    assert_eq!(events.len(), 3);
+    let requests = server.requests();
+    assert_eq!(requests.len(), 3);
+    // Every question asks for its schema, and the key goes in the header only.
+    for r in &requests {
+        let body = r.json();
+        assert_eq!(body["response_format"]["type"], "json_schema", "{body}");
+        assert_eq!(r.header("authorization"), Some("Bearer sk-test-secret"));
+        assert!(!body.to_string().contains("sk-test-secret"));
+    }
+    assert!(requests[0]
+        .json()
+        .to_string()
+        .contains("raise-up-left-hand"));
+}
+
+#[test]
+fn one_bad_reply_is_retried_with_its_error() {
+    let server = ScriptServer::start([
+        ScriptedReply::completion("I think the person walks."),
+        good("rewrite"),
+        good("segment"),
+        good("decompose"),
+    ])
+    .unwrap();
+    let (plan, _) = run(&server);
+    assert!(plan.notes.is_empty(), "{:?}", plan.notes);
+    let retry = server.requests()[1].json();
+    let messages = retry["messages"].as_array().unwrap();
+    let last = messages.last().unwrap()["content"].to_string();
+    assert!(last.contains("cannot be used"), "{last}");
+}
+
+#[test]
+fn no_server_at_all_gives_the_offline_plan_with_a_note() {
+    let port = {
+        let l = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        l.local_addr().unwrap().port()
+    };
+    let mut config = LlmConfig::new(format!("http://127.0.0.1:{port}/v1"), "absent");
+    config.max_retries = 0;
+    let client = LlmClient::native(config).unwrap();
+    let plan = block_on(plan(&client, PROMPT, &vocabulary(), None, &mut |_| {}));
+    let offline = offline::plan(PROMPT, None);
+    assert_eq!(plan.segments, offline.segments);
+    assert!(
+        plan.notes.iter().any(|n| n.contains("could not reach")),
+        "{:?}",
+        plan.notes
+    );
+}
+
+/// One line of the hostile fixture: a reply aimed at one step.
+#[derive(serde::Deserialize)]
+struct Hostile {
+    step: String,
+    why: String,
+}
+
+#[test]
+fn every_hostile_reply_is_handled_with_a_note_and_a_fallback() {
+    let text = include_str!("../../../../tests/fixtures/llm/hostile.jsonl");
+    let mut count = 0;
+    let mut failures = Vec::new();
+    for line in text.lines().filter(|l| !l.trim().is_empty()) {
+        let hostile: Hostile = serde_json::from_str(line).unwrap();
+        let reply = ScriptedReply::from_json_lines(line).unwrap().remove(0);
+        // Good replies before the step under test; the hostile one for it and every later
+        // request, so whatever the planner asks next, it meets the same reply.
+        let before: &[&str] = match hostile.step.as_str() {
+            "rewrite" => &[],
+            "segment" => &["rewrite"],
+            _ => &["rewrite", "segment"],
+        };
+        let mut replies: Vec<ScriptedReply> = before.iter().map(|s| good(s)).collect();
+        replies.extend(std::iter::repeat_n(reply, 16));
+        let server = ScriptServer::start(replies).unwrap();
+        let (plan, _) = run(&server);
+        let context = format!("{} ({})", hostile.why, hostile.step);
+        assert_valid(&plan, &context);
+        // A reply with one good JSON object and junk after it is read as that object:
+        // the step then succeeds, with data that passed validation.
+        let lenient = hostile.why == "trailing garbage";
+        if !lenient
+            && !plan
+                .notes
+                .iter()
+                .any(|n| n.contains(&format!("LLM's {}", hostile.step)))
+        {
+            failures.push(format!("{context}: no fallback note in {:?}", plan.notes));
+        }
+        for note in &plan.notes {
+            assert!(
+                note.chars().count() < 1200,
+                "{context}: a note of {} chars",
+                note.len()
+            );
+            assert!(!note.contains("sk-test-secret"));
+        }
+        if hostile.step == "decompose" {
+            // The offline planner took over the segment: no path came from the reply.
+            if plan.segments[0].trajectory.is_some() {
+                failures.push(format!("{context}: kept a path from the reply"));
+            }
+        }
+        count += 1;
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(count >= 100, "only {count} hostile replies");
+}
+
+#[test]
+fn a_valid_curve_from_the_llm_is_kept_as_data() {
+    let server = ScriptServer::start([
+        good("rewrite"),
+        good("segment"),
+        ScriptedReply::completion(
+            r#"{"base": "a person walks forward", "left_arm": null, "right_arm": null, "left_leg": null, "right_leg": null,
+                "trajectory": {"x": "sin(2*pi*t)", "z": "2*t", "t0": 0, "t1": 1}}"#,
+        ),
+    ])
+    .unwrap();
+    let (plan, _) = run(&server);
+    assert!(plan.notes.is_empty(), "{:?}", plan.notes);
+    let t = plan.segments[0].trajectory.as_ref().expect("a path");
+    t.validate().unwrap();
+}

@@ -1,0 +1,705 @@
+//! The built-in planner: deterministic rules over the prompt's words, no LLM.
+//!
+//! 1. The prompt is cut into clauses at sentence ends and temporal connectives ("then",
+//!    "after that", "finally", "before", "after", a comma or "and" that starts a new verb);
+//!    "while" joins two clauses into one. "Before Y, X" and "X after Y" are put in time order.
+//! 2. Each clause gets its movements from [`lexicon`]: one whole-body or walking motion as the
+//!    base, and arm gestures beside it as part edits ("walks forward waving the left hand").
+//!    A clause with no verb inherits the previous clause's gesture ("then the left hand").
+//! 3. Repetitions ("twice") repeat the clause; durations come from "for N seconds", the
+//!    action's usual length and tempo words; paths ("in a circle clockwise") from the
+//!    trajectory shape library; style words ("angry", "elderly") become the caption phrases
+//!    the data uses.
+//! 4. A clause with no known movement is mapped to the nearest training action by sentence
+//!    similarity when an embedder is given, and dropped otherwise, with a note either way.
+
+use super::lexicon::{self, Action, Direction, Side};
+use crate::agents::plan::{
+    clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS, MAX_TEXT_CHARS,
+};
+use crate::skeleton::BodyPart;
+use crate::trajectory::{Shape, Trajectory};
+
+/// Turns a sentence into a unit embedding (MiniLM); the planner uses it to map movements it
+/// has no rule for onto the nearest action of the training data.
+pub type Embedder<'a> = &'a dyn Fn(&str) -> Vec<f32>;
+
+/// Lowest cosine similarity at which an unknown clause is mapped onto a training action.
+pub const NEAREST_MIN_SIMILARITY: f32 = 0.35;
+
+/// Longest prompt read, in characters; the rest is ignored with a note.
+pub const MAX_PROMPT_CHARS: usize = 2000;
+
+/// Plans `prompt` with the built-in rules. `embed` (optional) maps unknown movements onto the
+/// training actions. Always returns a plan of 1 to [`MAX_SEGMENTS`] segments.
+pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
+    let mut notes = Vec::new();
+    let mut text: String = prompt.chars().take(MAX_PROMPT_CHARS).collect();
+    if prompt.chars().count() > MAX_PROMPT_CHARS {
+        notes.push(format!(
+            "the prompt is longer than {MAX_PROMPT_CHARS} characters; the rest was not read"
+        ));
+    }
+    text = text.to_lowercase();
+    let style = prompt_style(&text);
+    let mut segments: Vec<Segment> = Vec::new();
+    let mut previous: Option<Action> = None;
+    for clause in clauses(&text) {
+        let words: Vec<&str> = clause.iter().map(String::as_str).collect();
+        let found = match movements(&words, previous) {
+            Some(found) => found,
+            None => match nearest_action(&words, embed) {
+                Some((action, similarity)) => {
+                    notes.push(format!(
+                        "\"{}\" is not a movement the model knows; used the nearest one, \"{}\" \
+                         (similarity {similarity:.2})",
+                        words.join(" "),
+                        action.verb_phrase()
+                    ));
+                    Movements {
+                        base: action,
+                        gestures: Vec::new(),
+                    }
+                }
+                None => {
+                    if !words.is_empty() {
+                        notes.push(format!(
+                            "\"{}\" names no movement the model makes; left out",
+                            words.join(" ")
+                        ));
+                    }
+                    continue;
+                }
+            },
+        };
+        previous = Some(found.gestures.last().copied().unwrap_or(found.base));
+        let segment = segment(&words, &found, style.as_deref());
+        for _ in 0..lexicon::repetitions(&words) {
+            segments.push(segment.clone());
+        }
+    }
+    if segments.is_empty() {
+        let fallback = crate::agents::plan::clean_text(prompt)
+            .unwrap_or_else(|_| "a person walks forward".into());
+        let fallback: String = fallback.chars().take(MAX_TEXT_CHARS).collect();
+        notes.push("no known movement in the prompt; the model gets the prompt as it is".into());
+        segments.push(Segment {
+            text: fallback.clone(),
+            seconds: 4.0,
+            base: fallback,
+            parts: PartEdits::default(),
+            trajectory: None,
+        });
+    }
+    if segments.len() > MAX_SEGMENTS {
+        let dropped: Vec<String> = segments[MAX_SEGMENTS..]
+            .iter()
+            .map(|s| s.text.clone())
+            .collect();
+        notes.push(format!(
+            "a plan has at most {MAX_SEGMENTS} segments; left out: {}",
+            dropped.join("; ")
+        ));
+        segments.truncate(MAX_SEGMENTS);
+    }
+    Plan {
+        prompt: prompt.to_string(),
+        rewritten: rewrite(&segments),
+        segments,
+        planner: PlannerKind::Offline,
+        notes,
+    }
+}
+
+/// The segments' texts as one description ("a person walks forward, then a person bows").
+pub fn rewrite(segments: &[Segment]) -> String {
+    segments
+        .iter()
+        .map(|s| s.text.as_str())
+        .collect::<Vec<_>>()
+        .join(", then ")
+}
+
+/// What a clause asks for: a base motion and the gestures that ride on it.
+#[derive(Clone, Debug, PartialEq)]
+struct Movements {
+    base: Action,
+    gestures: Vec<Action>,
+}
+
+/// How a clause starts: a marker that changes its order or merges it with the next one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Marker {
+    None,
+    /// "before ...": happens after the clause it is attached to, when it leads the sentence.
+    Before,
+    /// "after ...": happens before the clause it follows.
+    After,
+    /// "while ...": at the same time as the next clause.
+    While,
+}
+
+/// A clause and how it joins the one before.
+struct Chunk {
+    words: Vec<String>,
+    marker: Marker,
+    /// Split at "and" with no other connective: undone when the clauses are a walk and a
+    /// gesture ("walks forward and waves"), which happen together.
+    soft: bool,
+}
+
+/// Words and punctuation of the prompt, lower case; hyphens and apostrophes split words.
+fn tokens(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut word = String::new();
+    let chars: Vec<char> = text.chars().collect();
+    for (i, &c) in chars.iter().enumerate() {
+        let decimal_point = c == '.'
+            && i > 0
+            && chars[i - 1].is_ascii_digit()
+            && chars.get(i + 1).is_some_and(|n| n.is_ascii_digit());
+        if c.is_alphanumeric() || decimal_point {
+            word.push(c);
+            continue;
+        }
+        if !word.is_empty() {
+            out.push(std::mem::take(&mut word));
+        }
+        match c {
+            ',' | ':' => out.push(",".into()),
+            '.' | ';' | '!' | '?' | '\n' => out.push(".".into()),
+            _ => {}
+        }
+    }
+    if !word.is_empty() {
+        out.push(word);
+    }
+    out
+}
+
+/// True when the words start a new verb phrase, after an optional subject.
+fn starts_verb(words: &[String]) -> bool {
+    let mut i = 0;
+    // Determiners take a noun, and the noun an adjective or two: "the old man bows".
+    while i < words.len() && i < 4 {
+        let w = words[i].as_str();
+        let next: Vec<&str> = words[i + 1..].iter().take(3).map(String::as_str).collect();
+        if lexicon::is_finite_verb(w) && !(w == "turn" && next.first() == Some(&"to")) {
+            // "left" after "turn" is part of the verb; a bare side word is not a verb.
+            return action_or_other(w, &next);
+        }
+        if !lexicon::is_subject_word(w) && i > 0 && !lexicon::is_subject_word(&words[i - 1]) {
+            return false;
+        }
+        i += 1;
+    }
+    false
+}
+
+fn action_or_other(word: &str, next: &[&str]) -> bool {
+    match word {
+        "turn" | "turns" => lexicon::action_word(word, next, &[]).is_some(),
+        _ => true,
+    }
+}
+
+/// Cuts the prompt into clauses in time order.
+fn clauses(text: &str) -> Vec<Vec<String>> {
+    let tokens = tokens(text);
+    let mut out = Vec::new();
+    for sentence in tokens.split(|t| t == ".") {
+        out.extend(sentence_clauses(sentence));
+    }
+    out
+}
+
+fn sentence_clauses(sentence: &[String]) -> Vec<Vec<String>> {
+    let mut chunks: Vec<Chunk> = vec![Chunk {
+        words: Vec::new(),
+        marker: Marker::None,
+        soft: false,
+    }];
+    let mut i = 0;
+    let word = |k: usize| sentence.get(k).map(String::as_str).unwrap_or("");
+    let new_chunk = |chunks: &mut Vec<Chunk>, marker: Marker, soft: bool| {
+        if chunks.last().is_some_and(|c| c.words.is_empty()) {
+            let last = chunks.last_mut().unwrap();
+            if last.marker == Marker::None {
+                last.marker = marker;
+            }
+            last.soft &= soft;
+        } else {
+            chunks.push(Chunk {
+                words: Vec::new(),
+                marker,
+                soft,
+            });
+        }
+    };
+    while i < sentence.len() {
+        let w = word(i);
+        let rest = &sentence[i + 1..];
+        match w {
+            "," => {
+                let after = rest
+                    .iter()
+                    .position(|t| !matches!(t.as_str(), "and" | "then" | "finally" | ","))
+                    .unwrap_or(rest.len());
+                let connective = rest[..after].iter().any(|t| t == "then" || t == "finally");
+                if connective || starts_verb(&rest[after..]) || starts_connective(rest) {
+                    new_chunk(&mut chunks, Marker::None, false);
+                }
+                i += 1;
+                continue;
+            }
+            "then" | "finally" | "afterwards" | "afterward" | "later" | "eventually" => {
+                new_chunk(&mut chunks, Marker::None, false);
+                i += 1;
+                continue;
+            }
+            "next" if starts_verb(rest) || rest.first().is_some_and(|t| t == ",") => {
+                new_chunk(&mut chunks, Marker::None, false);
+                i += 1;
+                continue;
+            }
+            "and" => {
+                let skip = rest
+                    .iter()
+                    .take_while(|t| matches!(t.as_str(), "then" | "finally"))
+                    .count();
+                if skip > 0 {
+                    new_chunk(&mut chunks, Marker::None, false);
+                } else if starts_verb(rest) {
+                    new_chunk(&mut chunks, Marker::None, true);
+                } else {
+                    chunks.last_mut().unwrap().words.push(w.to_string());
+                }
+                i += 1;
+                continue;
+            }
+            "after" if word(i + 1) == "that" || word(i + 1) == "this" => {
+                new_chunk(&mut chunks, Marker::None, false);
+                i += 2;
+                continue;
+            }
+            "followed" if word(i + 1) == "by" => {
+                new_chunk(&mut chunks, Marker::None, false);
+                i += 2;
+                continue;
+            }
+            "before" => {
+                new_chunk(&mut chunks, Marker::Before, false);
+                i += 1;
+                continue;
+            }
+            "after" => {
+                new_chunk(&mut chunks, Marker::After, false);
+                i += 1;
+                continue;
+            }
+            "while" | "whilst" if chunks.last().is_some_and(|c| c.words.is_empty()) => {
+                chunks.last_mut().unwrap().marker = Marker::While;
+                i += 1;
+                continue;
+            }
+            "first" | "firstly" | "initially" => {
+                i += 1;
+                continue;
+            }
+            _ => {}
+        }
+        chunks.last_mut().unwrap().words.push(w.to_string());
+        i += 1;
+    }
+    chunks.retain(|c| !c.words.is_empty());
+    order(chunks)
+}
+
+fn starts_connective(rest: &[String]) -> bool {
+    matches!(
+        rest.first().map(String::as_str),
+        Some("before" | "after" | "afterwards" | "later" | "next")
+    )
+}
+
+/// Puts "before" and "after" clauses in time order, joins "while" clauses and the soft "and"
+/// splits that are one movement.
+fn order(chunks: Vec<Chunk>) -> Vec<Vec<String>> {
+    let mut out: Vec<Chunk> = Vec::new();
+    let mut pending_before: Option<Chunk> = None;
+    let mut pending_while: Option<Chunk> = None;
+    for (k, mut chunk) in chunks.into_iter().enumerate() {
+        if let Some(w) = pending_while.take() {
+            let mut words = w.words;
+            words.append(&mut chunk.words);
+            chunk.words = words;
+        }
+        match chunk.marker {
+            Marker::While => {
+                pending_while = Some(chunk);
+                continue;
+            }
+            Marker::Before if k == 0 => {
+                pending_before = Some(chunk);
+                continue;
+            }
+            Marker::After if !out.is_empty() => {
+                let last = out.len() - 1;
+                out.insert(last, chunk);
+                continue;
+            }
+            _ => {}
+        }
+        if chunk.soft {
+            if let Some(last) = out.last_mut() {
+                if soft_join(&last.words, &chunk.words) {
+                    last.words.push("and".into());
+                    last.words.append(&mut chunk.words);
+                    continue;
+                }
+            }
+        }
+        out.push(chunk);
+        if let Some(b) = pending_before.take() {
+            out.push(b);
+        }
+    }
+    out.extend(pending_while);
+    out.extend(pending_before);
+    out.into_iter().map(|c| c.words).collect()
+}
+
+/// "walks forward and waves the left hand" is one movement: a walk carrying a gesture.
+fn soft_join(left: &[String], right: &[String]) -> bool {
+    let l: Vec<&str> = left.iter().map(String::as_str).collect();
+    let r: Vec<&str> = right.iter().map(String::as_str).collect();
+    let (Some(a), Some(b)) = (movements(&l, None), movements(&r, None)) else {
+        return false;
+    };
+    a.base.is_locomotion() && b.base.is_gesture() && b.gestures.is_empty()
+}
+
+/// The movements of one clause; `previous` lends its gesture to a clause with no verb ("then
+/// the left hand").
+fn movements(words: &[&str], previous: Option<Action>) -> Option<Movements> {
+    let mut actions: Vec<(usize, Action)> = Vec::new();
+    for (i, w) in words.iter().enumerate() {
+        let next = &words[i + 1..];
+        let prev = &words[..i];
+        let prev_rev: Vec<&str> = prev.iter().rev().copied().collect();
+        let Some(mut action) = lexicon::action_word(w, next, &prev_rev) else {
+            continue;
+        };
+        if *w == "sword" && actions.iter().any(|(_, a)| *a == Action::Slash) {
+            continue;
+        }
+        action = match action {
+            Action::Walk(Direction::Forward) => Action::Walk(direction(next)),
+            a if a.is_gesture() => {
+                a.with_side(side(words, i).unwrap_or(if lexicon::both_by_default(w) {
+                    Side::Both
+                } else {
+                    default_side(a)
+                }))
+            }
+            a => a,
+        };
+        // "waves goodbye with his left hand" is a wave of that hand.
+        if action == Action::Goodbye {
+            if let Some(s) = side(words, i) {
+                action = Action::Wave(s);
+            }
+        }
+        if actions.iter().any(|(_, a)| same_kind(*a, action)) {
+            continue;
+        }
+        actions.push((i, action));
+    }
+    if actions.is_empty() {
+        let side = words.iter().find_map(|w| side_word(w))?;
+        let previous = previous.filter(|a| a.is_gesture())?;
+        return Some(Movements {
+            base: previous.with_side(side),
+            gestures: Vec::new(),
+        });
+    }
+    // A walk turning and walking is one turn.
+    if let Some(turn) = actions.iter().position(|(_, a)| {
+        matches!(
+            a,
+            Action::Walk(Direction::TurnLeft) | Action::Walk(Direction::TurnRight)
+        )
+    }) {
+        let turn = actions[turn].1;
+        actions.retain(|(_, a)| !matches!(a, Action::Walk(_)) || *a == turn);
+    }
+    let base_index = actions
+        .iter()
+        .position(|(_, a)| !a.is_gesture())
+        .unwrap_or(0);
+    let base = actions[base_index].1;
+    let mut used: Vec<BodyPart> = base.arms().to_vec();
+    let mut gestures = Vec::new();
+    for (k, (_, a)) in actions.iter().enumerate() {
+        if k == base_index || !a.is_gesture() {
+            continue;
+        }
+        if a.arms().iter().any(|p| used.contains(p)) {
+            continue;
+        }
+        used.extend_from_slice(a.arms());
+        gestures.push(*a);
+    }
+    Some(Movements { base, gestures })
+}
+
+fn same_kind(a: Action, b: Action) -> bool {
+    std::mem::discriminant(&a) == std::mem::discriminant(&b) && a == b
+        || matches!((a, b), (Action::Walk(_), Action::Walk(_)))
+            && !matches!(
+                b,
+                Action::Walk(Direction::TurnLeft) | Action::Walk(Direction::TurnRight)
+            )
+}
+
+fn default_side(action: Action) -> Side {
+    match action {
+        Action::Goodbye => Side::Right,
+        _ => Side::Right,
+    }
+}
+
+fn side_word(word: &str) -> Option<Side> {
+    match word {
+        "left" => Some(Side::Left),
+        "right" => Some(Side::Right),
+        "both" | "hands" | "arms" => Some(Side::Both),
+        _ => None,
+    }
+}
+
+/// The side a gesture at `i` names: a few words after it ("waves the left hand"), or before
+/// ("with the left arm raised").
+fn side(words: &[&str], i: usize) -> Option<Side> {
+    let stop = |w: &str| {
+        lexicon::action_word(w, &[], &[]).is_some_and(|a| !a.is_gesture())
+            || matches!(w, "while" | "then" | "and")
+    };
+    for w in words.iter().skip(i + 1).take(5) {
+        if stop(w) {
+            break;
+        }
+        if let Some(s) = side_word(w) {
+            return Some(s);
+        }
+    }
+    for w in words[..i].iter().rev().take(4) {
+        if stop(w) {
+            break;
+        }
+        if let Some(s) = side_word(w) {
+            return Some(s);
+        }
+    }
+    None
+}
+
+/// Where a walk goes, from the words after the verb up to the next movement.
+fn direction(next: &[&str]) -> Direction {
+    for (k, w) in next.iter().take(4).enumerate() {
+        match *w {
+            "backward" | "backwards" | "back" => return Direction::Backward,
+            "left" | "leftward" | "leftwards" => return Direction::Left,
+            "right" | "rightward" | "rightwards" => return Direction::Right,
+            "forward" | "forwards" | "ahead" | "straight" => return Direction::Forward,
+            "sideways" => {
+                if next[k..].iter().take(4).any(|w| *w == "right") {
+                    return Direction::Right;
+                }
+                return Direction::Left;
+            }
+            w if matches!(w, "with" | "while" | "and" | "then" | ",")
+                || lexicon::action_word(w, &[], &[]).is_some() =>
+            {
+                break
+            }
+            _ => {}
+        }
+    }
+    Direction::Forward
+}
+
+/// The style the whole prompt asks for ("an angry person walks …"), as caption words.
+fn prompt_style(text: &str) -> Option<String> {
+    tokens(text)
+        .iter()
+        .find_map(|w| lexicon::style_word(w).map(String::from))
+}
+
+/// A clause of no known movement mapped onto the nearest training action by similarity.
+fn nearest_action(words: &[&str], embed: Option<Embedder>) -> Option<(Action, f32)> {
+    let embed = embed?;
+    if words.is_empty()
+        || !words
+            .iter()
+            .any(|w| lexicon::is_finite_verb(w) || w.len() > 3)
+    {
+        return None;
+    }
+    if words
+        .iter()
+        .all(|w| NOT_MOVEMENT.contains(w) || is_filler(w))
+    {
+        return None;
+    }
+    let query = embed(&format!("a person {}", words.join(" ")));
+    TRAINING_ACTIONS
+        .iter()
+        .map(|a| (*a, cosine(&query, &embed(&a.caption()))))
+        .filter(|(_, s)| *s >= NEAREST_MIN_SIMILARITY)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Verbs of standing still or of no movement at all: a clause of only these is no segment.
+const NOT_MOVEMENT: &[&str] = &[
+    "stop", "stops", "stopping", "stand", "stands", "standing", "still", "pause", "pauses", "wait",
+    "waits", "rest", "rests", "laugh", "laughs", "laughing", "smile", "smiles", "smiling", "look",
+    "looks", "looking", "talk", "talks", "talking", "freeze", "freezes",
+];
+
+fn is_filler(word: &str) -> bool {
+    lexicon::is_subject_word(word)
+        || matches!(
+            word,
+            "man"
+                | "woman"
+                | "he"
+                | "his"
+                | "her"
+                | "their"
+                | "for"
+                | "of"
+                | "at"
+                | "on"
+                | "in"
+                | "to"
+                | "end"
+                | "ceremony"
+                | "moment"
+                | "while"
+                | "there"
+                | "and"
+        )
+}
+
+/// The actions the model was trained on, as candidates for unknown movements.
+const TRAINING_ACTIONS: [Action; 16] = [
+    Action::Walk(Direction::Forward),
+    Action::Walk(Direction::Backward),
+    Action::Walk(Direction::TurnLeft),
+    Action::Walk(Direction::TurnRight),
+    Action::Run,
+    Action::Dash,
+    Action::Bow,
+    Action::Kick,
+    Action::Punch,
+    Action::Slash,
+    Action::Dance,
+    Action::Beckon,
+    Action::Guide,
+    Action::Wave(Side::Both),
+    Action::Goodbye,
+    Action::Raise(Side::Both),
+];
+
+fn cosine(a: &[f32], b: &[f32]) -> f32 {
+    let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    let na = a.iter().map(|x| x * x).sum::<f32>().sqrt();
+    let nb = b.iter().map(|x| x * x).sum::<f32>().sqrt();
+    dot / (na * nb).max(1e-9)
+}
+
+/// The segment of one clause.
+fn segment(words: &[&str], found: &Movements, style: Option<&str>) -> Segment {
+    let own_style = words.iter().find_map(|w| lexicon::style_word(w));
+    let style = own_style.or(style);
+    let with_style = |caption: String| match style {
+        Some(s) => format!("{caption} {s}"),
+        None => caption,
+    };
+    let base = with_style(found.base.caption());
+    let mut parts = PartEdits::default();
+    let mut text = found.base.caption();
+    for g in &found.gestures {
+        for part in g.arms() {
+            parts.set(*part, Some(with_style(g.caption())));
+        }
+        text = format!("{text} {}", g.participle());
+    }
+    let text = with_style(text);
+    let trajectory = if found.base.is_locomotion()
+        && !matches!(
+            found.base,
+            Action::Walk(Direction::TurnLeft | Direction::TurnRight)
+        ) {
+        path(words)
+    } else {
+        None
+    };
+    let usual = match &trajectory {
+        Some(Trajectory::Shape { shape }) => path_seconds(*shape),
+        _ => found.base.seconds(),
+    };
+    let seconds = duration(words).unwrap_or_else(|| {
+        let tempo: f64 = words
+            .iter()
+            .filter_map(|w| lexicon::tempo_word(w))
+            .product();
+        let few = words.windows(2).any(|w| w == ["few", "steps"]);
+        let long = words.windows(2).any(|w| w == ["a", "while"]);
+        usual * tempo * if few { 0.75 } else { 1.0 } * if long { 1.5 } else { 1.0 }
+    });
+    Segment {
+        text,
+        seconds: clamp_seconds(seconds).unwrap_or(usual),
+        base,
+        parts,
+        trajectory,
+    }
+}
+
+/// "for 3 seconds", "for 2.5 s", "for five seconds".
+fn duration(words: &[&str]) -> Option<f64> {
+    words.windows(3).find_map(|w| {
+        let unit = matches!(w[2], "seconds" | "second" | "secs" | "sec" | "s");
+        (w[0] == "for" && unit)
+            .then(|| lexicon::number(w[1]))
+            .flatten()
+    })
+}
+
+/// The root path a clause names ("in a circle clockwise", "zigzag", "s shaped").
+fn path(words: &[&str]) -> Option<Trajectory> {
+    let trajectory = Trajectory::from_text(&words.join(" "))?;
+    // A turn is in the training data as a motion of its own; the planner asks for that.
+    match trajectory {
+        Trajectory::Shape {
+            shape: Shape::Turn(_),
+        } => None,
+        t => Some(t),
+    }
+}
+
+/// A usual length in seconds for walking a shape at about 1.2 m/s: long enough to make a
+/// closed shape recognisable, within one generation.
+fn path_seconds(shape: Shape) -> f64 {
+    match shape {
+        Shape::Line => 4.0,
+        Shape::Arc(_) | Shape::Turn(_) => 5.0,
+        Shape::Zigzag(_) | Shape::SCurve(_) => 6.0,
+        _ => 9.0,
+    }
+}
+
+#[cfg(test)]
+mod tests;

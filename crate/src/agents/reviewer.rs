@@ -1,0 +1,288 @@
+//! The reviewer: describes a generated segment, compares it with what the segment asked for,
+//! body part by body part, and returns correction instructions (or none).
+//!
+//! - Describer: pose codes ([`crate::posecodes`]), always available; optionally a vision
+//!   model that looks at a filmstrip of the colour-coded skeleton.
+//! - Judge: the configured LLM, or without one the motion evaluator's text–motion
+//!   similarity for each part's instruction against [`OFFLINE_THRESHOLD`].
+
+use crate::agents::llm::{
+    parse_json_content, ChatOptions, LlmClient, Message, ReplyFormat, Transport,
+};
+use crate::agents::plan::{clean_text, Segment};
+use crate::eval::evaluator::{alignment_score, Evaluator, EvaluatorConfig};
+use crate::features::FeatureFrame;
+use crate::model::MotionModel;
+use crate::posecodes;
+use crate::render::{filmstrip_png, FilmstripOptions};
+use crate::skeleton::{BodyPart, Pose};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+
+/// The body regions a review speaks of: the arms one by one, the legs together (they carry
+/// the walk, so they are corrected as one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Region {
+    LeftArm,
+    RightArm,
+    LowerBody,
+}
+
+impl Region {
+    /// All regions, in the order they are reviewed.
+    pub const ALL: [Region; 3] = [Region::LeftArm, Region::RightArm, Region::LowerBody];
+
+    /// The model's body parts of the region.
+    pub fn parts(self) -> &'static [BodyPart] {
+        match self {
+            Region::LeftArm => &[BodyPart::LeftArm],
+            Region::RightArm => &[BodyPart::RightArm],
+            Region::LowerBody => &[BodyPart::LeftLeg, BodyPart::RightLeg],
+        }
+    }
+
+    /// What the segment asks of the region: its own edit, or the base motion.
+    pub fn asked(self, segment: &Segment) -> String {
+        let own = self.parts().iter().find_map(|p| segment.parts.get(*p));
+        own.unwrap_or(&segment.base).to_string()
+    }
+}
+
+/// A correction: regenerate the region's parts from `instruction`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Correction {
+    pub region: Region,
+    pub instruction: String,
+}
+
+/// Who judged.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum JudgeKind {
+    /// The evaluator's similarity against [`OFFLINE_THRESHOLD`].
+    Evaluator,
+    /// An LLM, by model id.
+    Llm { model: String },
+}
+
+/// One review of one segment.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Review {
+    /// What the motion looks like, in words (pose codes, or the vision model's words).
+    pub description: String,
+    /// The evaluator's 0–100 similarity of each region's instruction with the motion, where
+    /// an evaluator was at hand.
+    pub scores: Vec<(Region, f64)>,
+    /// What to regenerate; empty when the segment is done.
+    pub corrections: Vec<Correction>,
+    pub judge: JudgeKind,
+    /// Why the LLM judge was not used, when it failed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// Similarity (0–100) under which the offline judge asks for a region to be regenerated.
+/// Real test motions score about 60 against their own captions with the default evaluator
+/// (see EVAL.md), so a region well below that does not look like its text.
+pub const OFFLINE_THRESHOLD: f64 = 45.0;
+
+/// The local description of a motion: a whole-body sentence and one per body part.
+pub fn describe(poses: &[Pose]) -> String {
+    let whole = posecodes::describe_motion(poses);
+    let parts: Vec<String> = posecodes::part_sentences(poses)
+        .into_iter()
+        .map(|(_, s)| s)
+        .collect();
+    format!("{whole} In detail: {}.", parts.join("; "))
+}
+
+/// The motion evaluator with what it needs to score text against motion.
+pub struct Scorer<'a> {
+    pub evaluator: &'a Evaluator,
+    pub config: &'a EvaluatorConfig,
+    pub model: &'a MotionModel,
+}
+
+impl Scorer<'_> {
+    /// 0–100 similarity of each text with one motion (normalised features, 20 fps).
+    pub fn scores(&self, texts: &[String], normalized: &[FeatureFrame]) -> Vec<f64> {
+        let device = self.model.text.device();
+        let motion = &self
+            .evaluator
+            .embed_motions(self.config, &[normalized], device)[0];
+        let sentences: Vec<_> = texts
+            .iter()
+            .map(|t| self.model.text.encode(&[t.as_str()])[0])
+            .collect();
+        self.evaluator
+            .embed_texts(&sentences, device)
+            .iter()
+            .map(|t| alignment_score(t, motion))
+            .collect()
+    }
+
+    /// 0–100 similarity of a segment's whole text with its motion.
+    pub fn segment_score(&self, segment: &Segment, normalized: &[FeatureFrame]) -> f64 {
+        self.scores(std::slice::from_ref(&segment.text), normalized)[0]
+    }
+}
+
+/// The offline judge: every region whose instruction scores under [`OFFLINE_THRESHOLD`] is
+/// regenerated from that instruction.
+pub fn judge_offline(
+    segment: &Segment,
+    poses: &[Pose],
+    normalized: &[FeatureFrame],
+    scorer: &Scorer,
+) -> Review {
+    let asked: Vec<String> = Region::ALL.iter().map(|r| r.asked(segment)).collect();
+    let scores = scorer.scores(&asked, normalized);
+    let corrections = Region::ALL
+        .iter()
+        .zip(asked.iter().zip(&scores))
+        .filter(|(_, (_, s))| **s < OFFLINE_THRESHOLD)
+        .map(|(region, (text, _))| Correction {
+            region: *region,
+            instruction: text.clone(),
+        })
+        .collect();
+    Review {
+        description: describe(poses),
+        scores: Region::ALL.iter().copied().zip(scores).collect(),
+        corrections,
+        judge: JudgeKind::Evaluator,
+        note: None,
+    }
+}
+
+/// What the LLM judge replies: one instruction per region, or null.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JudgeReply {
+    left_arm: Option<String>,
+    right_arm: Option<String>,
+    lower_body: Option<String>,
+}
+
+fn judge_schema() -> serde_json::Value {
+    let part = json!({"type": ["string", "null"], "maxLength": 300});
+    json!({
+        "type": "object",
+        "properties": {"left_arm": part, "right_arm": part, "lower_body": part},
+        "required": ["left_arm", "right_arm", "lower_body"],
+        "additionalProperties": false
+    })
+}
+
+fn judge_messages(segment: &Segment, description: &str) -> Vec<Message> {
+    let asked: Vec<String> = Region::ALL
+        .iter()
+        .map(|r| format!("{:?}: {}", r, r.asked(segment)))
+        .collect();
+    vec![
+        Message::system(
+            "You check an animation against its instructions. You get what the segment should \
+             show, per body region, and a description of what the generated motion does. For \
+             each region (left_arm, right_arm, lower_body) that clearly fails its instruction, \
+             write a short corrective instruction as a caption about \"a person\" (\"a person \
+             raises the left hand high\"); use null for a region that is fine or that the \
+             description does not mention. Reply in JSON with exactly those three keys.",
+        ),
+        Message::user(format!(
+            "Segment: {}\nInstructions per region:\n{}\nWhat the motion does: {description}",
+            segment.text,
+            asked.join("\n")
+        )),
+    ]
+}
+
+/// The LLM judge; on any failure the offline review stands, with a note saying why.
+pub async fn judge_llm<T: Transport>(
+    client: &LlmClient<T>,
+    segment: &Segment,
+    offline: Review,
+) -> Review {
+    let format = ReplyFormat::JsonSchema {
+        name: "coma_review".into(),
+        schema: judge_schema(),
+    };
+    let messages = judge_messages(segment, &offline.description);
+    let reply = match client.chat(&messages, &format).await {
+        Ok(r) => r,
+        Err(e) => {
+            return Review {
+                note: Some(format!("the LLM judge failed ({e}); the evaluator judged")),
+                ..offline
+            }
+        }
+    };
+    let parsed = parse_json_content::<JudgeReply>(&reply.content).and_then(|r| {
+        let mut corrections = Vec::new();
+        for (region, text) in [
+            (Region::LeftArm, r.left_arm),
+            (Region::RightArm, r.right_arm),
+            (Region::LowerBody, r.lower_body),
+        ] {
+            let Some(text) = text.filter(|t| !t.trim().is_empty()) else {
+                continue;
+            };
+            if matches!(
+                text.trim().to_lowercase().as_str(),
+                "none" | "null" | "ok" | "fine"
+            ) {
+                continue;
+            }
+            corrections.push(Correction {
+                region,
+                instruction: clean_text(&text)?,
+            });
+        }
+        Ok(corrections)
+    });
+    match parsed {
+        Ok(corrections) => Review {
+            corrections,
+            judge: JudgeKind::Llm {
+                model: client.config().model.clone(),
+            },
+            ..offline
+        },
+        Err(e) => Review {
+            note: Some(format!(
+                "the LLM judge's reply was unusable ({e}); the evaluator judged"
+            )),
+            ..offline
+        },
+    }
+}
+
+/// Frames shown to a vision model: enough to see the movement, few enough to stay cheap.
+pub const VISION_FRAMES: usize = 8;
+
+/// Asks the configured vision model to describe a filmstrip of the motion; `None` (with the
+/// reason) when it cannot, in which case the pose-code description stands.
+pub async fn describe_with_vision<T: Transport>(
+    client: &LlmClient<T>,
+    poses: &[Pose],
+) -> Result<String, String> {
+    let options = FilmstripOptions {
+        frames: VISION_FRAMES,
+        ..FilmstripOptions::default()
+    };
+    let png = filmstrip_png(poses, &options).map_err(|e| e.to_string())?;
+    let messages = [
+        Message::system(
+            "You describe the movement of a stick figure in a filmstrip (time runs left to \
+             right, top to bottom). The left arm is drawn in one colour, the right arm in \
+             another, the legs in two more. Describe in two or three plain sentences what \
+             the body does: where it goes, and what each arm and the legs do.",
+        ),
+        Message::user_with_pngs("Describe this motion.", [png.as_slice()]),
+    ];
+    let reply = client
+        .chat_with(&messages, &ReplyFormat::Text, &ChatOptions::vision())
+        .await
+        .map_err(|e| e.to_string())?;
+    clean_text(&reply.content.chars().take(1200).collect::<String>())
+}
