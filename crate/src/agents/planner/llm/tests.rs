@@ -150,7 +150,7 @@ struct Hostile {
 
 #[test]
 fn every_hostile_reply_is_handled_with_a_note_and_a_fallback() {
-    let text = include_str!("../../../../tests/fixtures/llm/hostile.jsonl");
+    let text = include_str!("../../../../tests/fixtures/llm/planner_hostile.jsonl");
     let mut count = 0;
     let mut failures = Vec::new();
     for line in text.lines().filter(|l| !l.trim().is_empty()) {
