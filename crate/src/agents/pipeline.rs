@@ -487,3 +487,70 @@ pub fn describe_event(event: &RunEvent) -> String {
         RunEvent::Blended => "segments blended".to_string(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::agents::plan::{PartEdits, PlannerKind};
+
+    fn segment(seconds: f64, parts: PartEdits) -> Segment {
+        Segment {
+            text: "a person walks forward".into(),
+            seconds,
+            base: "a person walks forward".into(),
+            parts,
+            trajectory: None,
+        }
+    }
+
+    #[test]
+    fn parts_asked_the_same_thing_are_edited_together() {
+        let both = "a person waves both hands".to_string();
+        let s = segment(
+            4.0,
+            PartEdits {
+                left_arm: Some(both.clone()),
+                right_arm: Some(both.clone()),
+                left_leg: Some("a person kicks forward with a leg".into()),
+                right_leg: None,
+            },
+        );
+        let groups = grouped_edits(&s);
+        assert_eq!(groups.len(), 2);
+        assert_eq!(
+            groups[0],
+            (both, vec![BodyPart::LeftArm, BodyPart::RightArm])
+        );
+        assert_eq!(part_bits(&groups[0].1), 0b0011);
+        assert_eq!(part_bits(&[BodyPart::RightLeg]), 0b1000);
+    }
+
+    #[test]
+    fn every_sampling_of_a_run_has_its_own_seed() {
+        let mut seeds: Vec<u64> = (0..4)
+            .flat_map(|i| [0, 1, 2, 100, 110, 900].map(|k| seed_of(7, i, k)))
+            .collect();
+        let n = seeds.len();
+        seeds.sort_unstable();
+        seeds.dedup();
+        assert_eq!(seeds.len(), n);
+        assert_ne!(seed_of(7, 0, 0), seed_of(8, 0, 0));
+    }
+
+    #[test]
+    fn segments_keep_their_frames_in_the_blended_motion() {
+        let plan = Plan {
+            prompt: String::new(),
+            rewritten: String::new(),
+            segments: vec![
+                segment(4.0, PartEdits::default()),
+                segment(2.1, PartEdits::default()),
+            ],
+            planner: PlannerKind::Offline,
+            notes: Vec::new(),
+        };
+        // 80 frames = 20 steps, then 42 frames rounded up to 11 steps: 31 steps in all.
+        let tokens: MotionTokens = vec![vec![vec![0; 31]; 4]; 4];
+        assert_eq!(segment_ranges(&plan, &tokens), vec![0..80, 80..124]);
+    }
+}

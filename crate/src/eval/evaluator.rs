@@ -250,6 +250,30 @@ pub struct EvaluatorLoadError {
 }
 
 impl Evaluator {
+    /// The evaluator from the contents of `evaluator.json` and `evaluator.bpk` (no file
+    /// system, so it works in the page).
+    pub fn from_bytes(
+        config: &str,
+        weights: &[u8],
+        device: &Device,
+    ) -> Result<(Evaluator, EvaluatorConfig), EvaluatorLoadError> {
+        let error = |file: &str, message: String| EvaluatorLoadError {
+            file: file.to_string(),
+            message,
+        };
+        let config: EvaluatorConfig =
+            serde_json::from_str(config).map_err(|e| error("evaluator.json", e.to_string()))?;
+        let record = burn::store::ModuleRecord::from_bytes(burn::tensor::Bytes::from_bytes_vec(
+            weights.to_vec(),
+        ))
+        .map_err(|e| error("evaluator.bpk", format!("{e:?}")))?;
+        let model = config
+            .init(device)
+            .try_load_record(record)
+            .map_err(|e| error("evaluator.bpk", format!("{e:?}")))?;
+        Ok((model, config))
+    }
+
     /// Loads `evaluator.json` (its sizes) and `evaluator.bpk` from a folder (the default one
     /// lives in `static/models`).
     pub fn load(
@@ -339,6 +363,29 @@ mod tests {
         for (a, b) in alone[0].iter().zip(&together[0]) {
             assert!((a - b).abs() < 1e-4, "{a} vs {b}");
         }
+    }
+
+    #[test]
+    fn the_evaluator_loads_from_bytes_as_from_a_folder() {
+        let device = Device::flex();
+        let dir = tempfile::tempdir().unwrap();
+        let cfg = tiny();
+        cfg.save(dir.path().join("evaluator.json")).unwrap();
+        cfg.init(&device)
+            .save_file(dir.path().join("evaluator.bpk"))
+            .unwrap();
+        let (from_dir, _) = Evaluator::load(dir.path(), &device).unwrap();
+        let text = std::fs::read_to_string(dir.path().join("evaluator.json")).unwrap();
+        let weights = std::fs::read(dir.path().join("evaluator.bpk")).unwrap();
+        let (from_bytes, config) = Evaluator::from_bytes(&text, &weights, &device).unwrap();
+        assert_eq!(config.embedding, 8);
+        let sentence = [[0.3; TEXT_DIM]];
+        assert_eq!(
+            from_dir.embed_texts(&sentence, &device),
+            from_bytes.embed_texts(&sentence, &device)
+        );
+        assert!(Evaluator::from_bytes("{", &weights, &device).is_err());
+        assert!(Evaluator::from_bytes(&text, b"not weights", &device).is_err());
     }
 
     #[test]

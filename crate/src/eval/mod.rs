@@ -1,6 +1,9 @@
 //! Measuring the model: the text–motion evaluator, the field's metrics computed with it, the
-//! evaluation protocol and its report, and control probes.
+//! evaluation protocol and its report, control probes, and the agents' figures.
 
+// Runs the agents' loop to completion on this thread: native only.
+#[cfg(feature = "native")]
+pub mod agents;
 pub mod evaluator;
 pub mod metrics;
 pub mod probes;

@@ -51,6 +51,12 @@ pub struct EvalReport {
     pub options: ProtocolOptions,
     pub rows: BTreeMap<String, Row>,
     pub probes: Probes,
+    /// The planner, the review loop and the trajectory editor (native builds measure them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub agents: Option<serde_json::Value>,
+    /// The same figures, as markdown (made where they are measured).
+    #[serde(skip)]
+    pub agents_markdown: String,
     /// Wall-clock seconds the evaluation took.
     pub seconds: f64,
 }
@@ -136,7 +142,7 @@ impl EvalReport {
                 ));
             }
         }
-        md.push_str("| trajectory error | not measured yet (needs the trajectory editor) |\n");
+        md.push_str(&self.agents_markdown);
         md
     }
 }

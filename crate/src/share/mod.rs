@@ -22,6 +22,7 @@
 mod base64url;
 
 use crate::model::generate::MotionTokens;
+use serde::{Deserialize, Serialize};
 
 /// The payload version this code writes.
 pub const VERSION: u8 = 1;
@@ -43,8 +44,9 @@ pub const MAX_STEPS: usize = 4 * 50;
 /// Codes are 9 bits.
 pub const MAX_CODE: u32 = 511;
 
-/// What a step of the history did.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What a step of the history did. (Serde only for the page's worker messages; links use the
+/// byte layout above.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum EditKind {
     /// A whole motion from the prompt.
     Generate = 0,
@@ -75,7 +77,7 @@ impl EditKind {
 }
 
 /// One step of the edit history.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Edit {
     pub kind: EditKind,
     /// The instruction (or prompt) of the step.

@@ -182,6 +182,12 @@ enum Command {
         /// Leave SPAM out (real and retrieval rows only).
         #[arg(long)]
         no_spam: bool,
+        /// Prompt set for the planner and the review loop.
+        #[arg(long, default_value = "eval/prompts.json")]
+        prompts: PathBuf,
+        /// Review rounds (K) of the review-loop measurement; 0 skips it.
+        #[arg(long, default_value_t = 2)]
+        review_rounds: usize,
         #[arg(long, default_value = "EVAL.md")]
         markdown: PathBuf,
         #[arg(long, default_value = "eval.json")]
@@ -590,6 +596,47 @@ fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs
 }
 
 /// `coma eval`: the protocol's rows and the probes, written to EVAL.md and eval.json.
+/// What `coma eval` measures of the agents.
+struct AgentEvalOptions {
+    prompts: PathBuf,
+    review_rounds: usize,
+}
+
+/// The planner on the prompt set; with SPAM, the review loop over it and the circle probe.
+fn evaluate_agents(
+    spam: Option<&coma::model::MotionModel>,
+    evaluator: &coma::eval::evaluator::Evaluator,
+    config: &coma::eval::evaluator::EvaluatorConfig,
+    options: &AgentEvalOptions,
+) -> Result<coma::eval::agents::AgentFigures> {
+    use coma::eval::agents::{circle_probe, planner_figures, review_figures, AgentFigures};
+    let prompts = coma::agents::planner::prompt_set::load(&options.prompts)?;
+    let mut figures = AgentFigures {
+        planner: Some(planner_figures(&prompts, None)),
+        ..Default::default()
+    };
+    if let Some(model) = spam {
+        eprintln!("agents: the circle probe");
+        figures.circle = circle_probe(model, 0);
+        if options.review_rounds > 0 {
+            let scorer = coma::agents::reviewer::Scorer {
+                evaluator,
+                config,
+                model,
+            };
+            figures.review = Some(review_figures(
+                model,
+                &scorer,
+                &prompts,
+                options.review_rounds,
+                0,
+                &|l| eprintln!("{l}"),
+            ));
+        }
+    }
+    Ok(figures)
+}
+
 fn evaluate(
     evaluator_dir: &std::path::Path,
     data: &std::path::Path,
@@ -598,6 +645,7 @@ fn evaluate(
     probe_seeds: u64,
     markdown: &std::path::Path,
     json: &std::path::Path,
+    agent_options: &AgentEvalOptions,
 ) -> Result<()> {
     use coma::eval::protocol::{Protocol, Source};
     use coma::eval::report::{EvalReport, JoinSpeeds, Probes};
@@ -672,10 +720,13 @@ fn evaluate(
             p99_joint: join.p99_joint_speed,
         });
     }
+    let agents = evaluate_agents(spam.as_ref(), &evaluator, &config, agent_options)?;
     let command = std::env::args()
         .skip(1)
         .fold("coma".to_string(), |acc, a| acc + " " + &a);
     let report = EvalReport {
+        agents: Some(serde_json::to_value(&agents)?),
+        agents_markdown: agents.markdown(),
         command,
         evaluator_id,
         spam_id: spam.as_ref().map(|m| m.id.clone()),
@@ -970,6 +1021,8 @@ fn run(cli: Cli) -> Result<()> {
             markdown,
             json,
             model,
+            prompts,
+            review_rounds,
         } => {
             let options = coma::eval::protocol::ProtocolOptions {
                 repeats,
@@ -987,6 +1040,10 @@ fn run(cli: Cli) -> Result<()> {
                 probe_seeds,
                 &markdown,
                 &json,
+                &AgentEvalOptions {
+                    prompts,
+                    review_rounds,
+                },
             )?;
         }
         Command::Align {
