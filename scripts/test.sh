@@ -14,8 +14,14 @@ cargo clippy -p coma-web --target wasm32-unknown-unknown -- -D warnings
 echo "== features against the HumanML3D reference"
 cargo run --release -q -p coma -- features check ../shared/data/humanml3d-reference
 
-echo "== unit and integration tests"
+echo "== unit and integration tests (with a real local LLM server for tests/local_llm.rs)"
+# SmolLM2-135M under llama-cpp-python checks the client's plumbing against a real server; the
+# first run on a machine compiles llama.cpp once into a wheel cache (several minutes).
+COMA_LOCAL_LLM="$(scripts/llm_server.sh)"
+export COMA_LOCAL_LLM
+trap 'scripts/llm_server.sh stop' EXIT
 cargo test --workspace --release
+scripts/llm_server.sh stop
 
 echo "== the page builds"
 build_page

@@ -119,7 +119,7 @@ fn run_lays_a_clockwise_circle_on_the_root_and_writes_files() {
     for f in [
         "minilm-vocab.txt",
         "minilm-words.i8",
-        "minilm.bpk",
+        "minilm-encoder.bpk",
         "vocabulary.json",
     ] {
         std::fs::copy(repo().join("static/models").join(f), models.join(f)).unwrap();

@@ -334,6 +334,26 @@ fn a_server_without_structured_output_is_downgraded_once_and_remembered() {
 }
 
 #[test]
+fn llama_cpp_pythons_500_about_the_format_is_a_downgrade_that_keeps_the_schema() {
+    // What llama-cpp-python 0.3 answers to a json_schema response_format: a validation
+    // error under status 500. Its json_object mode takes the schema as an extension.
+    let server = ScriptServer::start([
+        ScriptedReply::new(
+            500,
+            r#"{"detail": [{"loc": ["body", "response_format", "type"], "msg": "Input should be 'text' or 'json_object'"}]}"#,
+        ),
+        ScriptedReply::completion("{\"segments\": []}"),
+    ])
+    .unwrap();
+    let client = client(&server);
+    let reply = ask(&client, &schema_format()).unwrap();
+    assert_eq!(reply.format, FormatLevel::JsonObject);
+    let sent = server.requests()[1].json();
+    assert_eq!(sent["response_format"]["type"], "json_object");
+    assert!(sent["response_format"]["schema"].is_object(), "{sent}");
+}
+
+#[test]
 fn downgrade_from_a_committed_fixture() {
     let fixture =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/llm/no_json_schema.jsonl");

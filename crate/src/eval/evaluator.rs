@@ -15,7 +15,14 @@
 //!
 //! Both sides end on the unit sphere, so cosine similarity is a dot product and the
 //! Euclidean distances of the field's metrics lie in [0, 2].
+//!
+//! Weights (`evaluator.bpk`, with its sizes in `evaluator.json`): training saves f32 (a burn
+//! `ModuleRecord`, a burnpack); `coma export evaluator` rounds every float parameter to f16
+//! ([`Evaluator::to_f16_bytes`]), halving the page's download (2.0 M parameters, 4 MB), and
+//! reports what that changes on the test split ([`agreement`]). Loading takes either and
+//! computes in f32: f16 values are widened on load.
 
+use super::metrics::r_precision;
 use crate::features::{FeatureFrame, FEATURE_DIM};
 use crate::model::transformer::TEXT_DIM;
 use burn::module::Param;
@@ -251,7 +258,8 @@ pub struct EvaluatorLoadError {
 
 impl Evaluator {
     /// The evaluator from the contents of `evaluator.json` and `evaluator.bpk` (no file
-    /// system, so it works in the page).
+    /// system, so it works in the page). The weights may be f32 or f16; f16 ones are widened
+    /// to f32.
     pub fn from_bytes(
         config: &str,
         weights: &[u8],
@@ -269,7 +277,7 @@ impl Evaluator {
         .map_err(|e| error("evaluator.bpk", format!("{e:?}")))?;
         let model = config
             .init(device)
-            .try_load_record(record)
+            .try_load_record(record.cast_to_module_dtype())
             .map_err(|e| error("evaluator.bpk", format!("{e:?}")))?;
         Ok((model, config))
     }
@@ -280,19 +288,121 @@ impl Evaluator {
         dir: &std::path::Path,
         device: &Device,
     ) -> Result<(Evaluator, EvaluatorConfig), EvaluatorLoadError> {
-        let error = |file: std::path::PathBuf, message: String| EvaluatorLoadError {
-            file: file.display().to_string(),
+        let config_path = dir.join("evaluator.json");
+        let config = EvaluatorConfig::load(&config_path).map_err(|e| EvaluatorLoadError {
+            file: config_path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let model = Self::load_weights(&config, &dir.join("evaluator.bpk"), device)?;
+        Ok((model, config))
+    }
+
+    /// Loads weights of the sizes `config` from a burnpack file (f32 as training saves them,
+    /// or f16 as [`Self::to_f16_bytes`] writes them; computing is f32 either way).
+    pub fn load_weights(
+        config: &EvaluatorConfig,
+        weights: &std::path::Path,
+        device: &Device,
+    ) -> Result<Evaluator, EvaluatorLoadError> {
+        let error = |message: String| EvaluatorLoadError {
+            file: weights.display().to_string(),
             message,
         };
-        let config_path = dir.join("evaluator.json");
-        let config = EvaluatorConfig::load(&config_path)
-            .map_err(|e| error(config_path.clone(), e.to_string()))?;
-        let weights = dir.join("evaluator.bpk");
-        let model = config
+        let record =
+            burn::store::ModuleRecord::load(weights).map_err(|e| error(format!("{e:?}")))?;
+        config
             .init(device)
-            .try_load_file(&weights)
-            .map_err(|e| error(weights.clone(), format!("{e:?}")))?;
-        Ok((model, config))
+            .try_load_record(record.cast_to_module_dtype())
+            .map_err(|e| error(format!("{e:?}")))
+    }
+
+    /// `evaluator.bpk` with every float parameter rounded to f16 (half the bytes): a burnpack
+    /// of the same tensor names and shapes as training's f32 file, without parameter ids, so
+    /// the same weights always give the same bytes. [`Self::from_bytes`] and [`Self::load`]
+    /// read it back as f32.
+    pub fn to_f16_bytes(&self) -> anyhow::Result<Vec<u8>> {
+        use burn::store::{bridge, burn_pack, ModuleSnapshot};
+        let mut tensors = Vec::new();
+        for tensor in self.collect(None, None, false) {
+            let name = tensor.name.clone();
+            let data = bridge::into_data(tensor).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+            let data = if data.dtype().is_float() {
+                data.convert_dtype(burn::tensor::DType::F16)
+            } else {
+                data
+            };
+            tensors.push(bridge::from_data(data, name, None));
+        }
+        let bytes = burn_pack::Writer::new(tensors)
+            .into_bytes()
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok(bytes.to_vec())
+    }
+}
+
+/// How far two evaluators (f32 weights and their f16 rounding, say) disagree on the same
+/// motions and captions (see [`agreement`]).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Agreement {
+    /// Motion–caption pairs compared (whole batches of 32).
+    pub pairs: usize,
+    /// Largest difference of [`alignment_score`] (0–100) over every caption–motion
+    /// combination of the pairs, matching or not.
+    pub max_score_difference: f64,
+    /// Mean of that difference.
+    pub mean_score_difference: f64,
+    /// R-precision top-1, top-2 and top-3 (batches of 32, as the protocol) with the first
+    /// and with the second evaluator.
+    pub r_precision: [[f64; 3]; 2],
+    /// Captions whose nearest motion within their batch differs between the two.
+    pub changed_nearest: usize,
+}
+
+/// Embeds `motions` (normalised features) and their captions' MiniLM `sentences` (one each)
+/// with `a` and `b`, both of the sizes `config`, and measures how far the scores and
+/// R-precision move. A last batch short of 32 is dropped.
+pub fn agreement(
+    a: &Evaluator,
+    b: &Evaluator,
+    config: &EvaluatorConfig,
+    motions: &[&[FeatureFrame]],
+    sentences: &[[f32; TEXT_DIM]],
+    device: &Device,
+) -> Agreement {
+    const BATCH: usize = 32;
+    let n = motions.len().min(sentences.len()) / BATCH * BATCH;
+    let embed = |e: &Evaluator| {
+        (
+            e.embed_texts(&sentences[..n], device),
+            e.embed_motions(config, &motions[..n], device),
+        )
+    };
+    let (ta, ma) = embed(a);
+    let (tb, mb) = embed(b);
+    let (mut max, mut sum) = (0f64, 0f64);
+    for i in 0..n {
+        for j in 0..n {
+            let d = (alignment_score(&ta[i], &ma[j]) - alignment_score(&tb[i], &mb[j])).abs();
+            max = max.max(d);
+            sum += d;
+        }
+    }
+    let nearest = |t: &[Vec<f32>], m: &[Vec<f32>], i: usize| {
+        let start = i / BATCH * BATCH;
+        (start..start + BATCH)
+            .max_by(|&x, &y| {
+                alignment_score(&t[i], &m[x]).total_cmp(&alignment_score(&t[i], &m[y]))
+            })
+            .unwrap_or(i)
+    };
+    Agreement {
+        pairs: n,
+        max_score_difference: max,
+        mean_score_difference: sum / (n * n).max(1) as f64,
+        r_precision: [r_precision(&ta, &ma, BATCH), r_precision(&tb, &mb, BATCH)],
+        changed_nearest: (0..n)
+            .filter(|&i| nearest(&ta, &ma, i) != nearest(&tb, &mb, i))
+            .count(),
     }
 }
 
@@ -386,6 +496,58 @@ mod tests {
         );
         assert!(Evaluator::from_bytes("{", &weights, &device).is_err());
         assert!(Evaluator::from_bytes(&text, b"not weights", &device).is_err());
+    }
+
+    #[test]
+    fn f16_weights_load_as_f32_and_agree_with_the_original() {
+        let device = Device::flex();
+        let cfg = tiny();
+        let full = cfg.init(&device);
+        let f32_bytes = full.clone().into_record().into_bytes().unwrap().to_vec();
+        let f16_bytes = full.to_f16_bytes().unwrap();
+        assert!(
+            f16_bytes.len() * 10 < f32_bytes.len() * 6,
+            "{} bytes in f16, {} in f32",
+            f16_bytes.len(),
+            f32_bytes.len()
+        );
+        // The same weights give the same bytes (no parameter ids).
+        assert_eq!(f16_bytes, full.to_f16_bytes().unwrap());
+
+        let text = serde_json::to_string(&cfg).unwrap();
+        let (half, _) = Evaluator::from_bytes(&text, &f16_bytes, &device).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        cfg.save(dir.path().join("evaluator.json")).unwrap();
+        std::fs::write(dir.path().join("evaluator.bpk"), &f16_bytes).unwrap();
+        let (from_dir, _) = Evaluator::load(dir.path(), &device).unwrap();
+        assert_eq!(
+            half.text.hidden.weight.val().dtype(),
+            burn::tensor::DType::F32
+        );
+        let sentence = [[0.3; TEXT_DIM]];
+        assert_eq!(
+            half.embed_texts(&sentence, &device),
+            from_dir.embed_texts(&sentence, &device)
+        );
+
+        let motions: Vec<Vec<FeatureFrame>> = (0..64)
+            .map(|i| motion(8 + i % 17, (i as f32 * 0.37).sin()))
+            .collect();
+        let refs: Vec<&[FeatureFrame]> = motions.iter().map(Vec::as_slice).collect();
+        let sentences: Vec<[f32; TEXT_DIM]> = (0..64)
+            .map(|i| std::array::from_fn(|k| ((i * 7 + k) as f32 * 0.11).cos()))
+            .collect();
+        let same = agreement(&full, &full, &cfg, &refs, &sentences, &device);
+        assert_eq!(same.pairs, 64);
+        assert_eq!(same.max_score_difference, 0.0);
+        assert_eq!(same.changed_nearest, 0);
+        assert_eq!(same.r_precision[0], same.r_precision[1]);
+        let rounded = agreement(&full, &half, &cfg, &refs, &sentences, &device);
+        assert!(
+            rounded.max_score_difference < 0.5,
+            "f16 moves a score by {}",
+            rounded.max_score_difference
+        );
     }
 
     #[test]

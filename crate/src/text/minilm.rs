@@ -8,25 +8,27 @@
 //!   with one f32 scale per row (see [`WordEmbeddings`] for the format). It is read on the CPU
 //!   in plain Rust because a sentence touches a dozen of its rows: giving the whole table to
 //!   the tensor backend would cost memory for nothing.
-//! - `minilm.bpk`: everything else ([`MiniLm`]), a burnpack with f16 weights that are widened
-//!   to f32 on load.
+//! - `minilm-encoder.bpk`: everything else ([`MiniLm`]), 11 MB: a burnpack whose 36 Linear
+//!   weight matrices (attention query/key/value/output and the two feed-forward matrices of
+//!   each of the 6 layers, 10.6 M of the 10.8 M values) are int8 with one f32 scale per output,
+//!   and whose other tensors are f16 (see [`MiniLm`] for the format). Everything is widened to
+//!   f32 on load, so the encoder computes in f32.
 //!
 //! [`convert_minilm`] writes both from the original `model.safetensors`; [`SentenceEncoder`]
 //! ties them to the tokenizer. Results match sentence-transformers (mean pooling over real
-//! tokens, then L2 normalisation) to a cosine above 0.999.
+//! tokens, then L2 normalisation) to a cosine above 0.999 (`crate/tests/text.rs` checks it on
+//! 20 reference sentences).
 
 use super::tokenizer::{Tokenizer, VocabError};
 use burn::module::Module;
 use burn::nn::attention::{MhaInput, MultiHeadAttention, MultiHeadAttentionConfig};
 use burn::nn::{Embedding, EmbeddingConfig, LayerNorm, LayerNormConfig, Linear, LinearConfig};
 use burn::prelude::*;
-use burn::store::burn_pack::Tensor as PackTensor;
-use burn::store::{
-    BurnpackStore, HalfPrecisionAdapter, KeyRemapper, ModuleAdapter, ModuleContext, ModuleSnapshot,
-    PyTorchToBurnAdapter, SafetensorsStore,
-};
+use burn::store::burn_pack::{Reader as PackReader, Tensor as PackTensor, Writer as PackWriter};
+use burn::store::{bridge, KeyRemapper, ModuleSnapshot, PyTorchToBurnAdapter, SafetensorsStore};
 use burn::tensor::activation::gelu;
-use burn::tensor::Bytes;
+use burn::tensor::{Bytes, DType};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Width of the sentence embeddings and token states.
@@ -36,8 +38,9 @@ pub const EMBEDDING_DIM: usize = 384;
 pub const VOCAB_FILE: &str = "minilm-vocab.txt";
 /// The int8 word-embedding table (see [`WordEmbeddings`]) written by [`convert_minilm`].
 pub const WORDS_FILE: &str = "minilm-words.i8";
-/// The burnpack of the rest of the encoder ([`MiniLm`]) written by [`convert_minilm`].
-pub const MODEL_FILE: &str = "minilm.bpk";
+/// The burnpack of the rest of the encoder ([`MiniLm`], int8 Linear weights) written by
+/// [`convert_minilm`].
+pub const MODEL_FILE: &str = "minilm-encoder.bpk";
 
 /// Shape of the encoder; the defaults are all-MiniLM-L6-v2's `config.json`.
 #[derive(Config, Debug)]
@@ -147,6 +150,19 @@ impl EncoderLayer {
 ///        v
 ///  token states [B, L, 384]
 /// ```
+///
+/// File format ([`MODEL_FILE`], written by [`Self::to_bytes`]): a burnpack container (burn's
+/// own format, read with `burn::store::burn_pack`) with metadata `format` =
+/// [`Self::FORMAT`], and one tensor per parameter, named by its path in this module:
+///
+/// | tensors | dtype | shape | content |
+/// |---|---|---|---|
+/// | `layers.{0‥5}.{attention.query, attention.key, attention.value, attention.output, intermediate, output}.weight` (36) | i8 | `[in, out]` (burn's layout, PyTorch's transposed) | `q`, the weight being `w[i, o] ≈ q[i, o] · scale[o]` |
+/// | the same names + `_scale` | f32 | `[out]` | `scale[o] = max_i \|w[i, o]\| / 127`: symmetric, one per output (per row of PyTorch's `[out, in]` matrix), 0 for an all-zero output |
+/// | every other parameter: Linear biases, LayerNorm `gamma`/`beta`, `embeddings.position.weight` `[512, 384]`, `embeddings.token_type.weight` `[2, 384]` | f16 | as in the module | the value |
+///
+/// [`Self::from_bytes`] also takes f32 (or f16) for any tensor, and refuses a file with a
+/// tensor too many or too few.
 #[derive(Module, Debug)]
 pub struct MiniLm {
     embeddings: Embeddings,
@@ -172,49 +188,211 @@ impl MiniLm {
         x
     }
 
-    /// Loads an encoder from burnpack bytes written by [`convert_minilm`] (f16 weights,
-    /// widened to f32). Damaged bytes give an error, not a panic (checked for empty, garbage
-    /// and truncated input).
+    /// Value of the `format` metadata of [`MODEL_FILE`] (the table above).
+    pub const FORMAT: &'static str = "coma-minilm-encoder/1";
+    /// Name suffix of the scales of an int8 matrix.
+    const SCALE_SUFFIX: &'static str = "_scale";
+
+    /// Whether the parameter `name` of this module is stored as int8: the Linear weights of
+    /// the encoder layers (every `.weight` under `layers.`; the LayerNorms' are `gamma`).
+    fn stored_as_int8(name: &str) -> bool {
+        let linear = name.starts_with("layers.") && name.ends_with(".weight");
+        let attention = name.contains(".attention.");
+        let ff_output = !attention && name.ends_with(".output.weight");
+        match std::env::var("COMA_INT8_EXPERIMENT").as_deref() {
+            Ok("ff") => linear && !attention,
+            Ok("attention") => linear && attention,
+            Ok("no-ff-output") => linear && !ff_output,
+            Ok("none") => false,
+            _ => linear,
+        }
+    }
+
+    /// Loads an encoder from the bytes of [`MODEL_FILE`] (the format above), widening int8
+    /// and f16 tensors to f32. Damaged bytes give an error, not a panic (checked for empty,
+    /// garbage and truncated input, and for files of another format).
     pub fn from_bytes(bytes: &[u8], device: &Device) -> Result<MiniLm, MiniLmError> {
+        let error = |message: String| MiniLmError::Model(message);
+        let pack = |e: burn::store::burn_pack::Error| MiniLmError::Model(e.to_string());
+        let reader = PackReader::from_bytes(Bytes::from_bytes_vec(bytes.to_vec())).map_err(pack)?;
+        let format = reader.metadata().get("format").map(String::as_str);
+        if format != Some(Self::FORMAT) {
+            return Err(error(format!(
+                "format {format:?}, expected {:?} (an older minilm.bpk? convert again with \
+                 `coma text convert`)",
+                Self::FORMAT
+            )));
+        }
+        let mut tensors: BTreeMap<String, PackTensor> = reader
+            .into_tensors()
+            .map_err(pack)?
+            .into_iter()
+            .map(|t| (t.name.clone(), t))
+            .collect();
+        let scale_names: Vec<String> = tensors
+            .keys()
+            .filter(|name| name.ends_with(Self::SCALE_SUFFIX))
+            .cloned()
+            .collect();
+        let mut scales: BTreeMap<String, PackTensor> = scale_names
+            .into_iter()
+            .filter_map(|name| tensors.remove_entry(&name))
+            .collect();
+        let mut widened = Vec::with_capacity(tensors.len());
+        for (name, tensor) in tensors {
+            let data = bridge::into_data(tensor).map_err(pack)?;
+            let shape = data.shape().to_vec();
+            let values: Vec<f32> = match data.dtype() {
+                DType::I8 => {
+                    let scale_name = format!("{name}{}", Self::SCALE_SUFFIX);
+                    let scale = scales
+                        .remove(&scale_name)
+                        .ok_or_else(|| error(format!("{name}: int8 without {scale_name}")))?;
+                    let scale = bridge::into_data(scale).map_err(pack)?;
+                    dequantize_columns(&data, &scale).map_err(|m| error(format!("{name}: {m}")))?
+                }
+                DType::F16 | DType::F32 => data
+                    .try_into_vec_as::<f32>()
+                    .map_err(|e| error(format!("{name}: {e:?}")))?,
+                other => return Err(error(format!("{name}: unexpected dtype {other:?}"))),
+            };
+            widened.push(bridge::from_data(
+                TensorData::new(values, shape),
+                name,
+                None,
+            ));
+        }
+        if let Some(name) = scales.keys().next() {
+            return Err(error(format!("{name} scales no int8 matrix")));
+        }
         let mut model = MiniLmConfig::new().init(device);
-        let mut store = BurnpackStore::from_bytes(Some(Bytes::from_bytes_vec(bytes.to_vec())))
-            .with_from_adapter(HalfPrecisionAdapter::new());
-        model
-            .load_from(&mut store)
-            .map_err(|e| MiniLmError::Model(e.to_string()))?;
+        let result = model.apply(widened, None, None, false);
+        if !(result.errors.is_empty() && result.missing.is_empty() && result.unused.is_empty()) {
+            return Err(error(result.to_string()));
+        }
         Ok(model)
     }
 
-    /// Burnpack bytes of this encoder with Linear, Embedding and LayerNorm weights in f16 (the
-    /// download is half the size; the encoder's outputs move by less than 1e-3 in cosine).
+    /// The bytes of [`MODEL_FILE`] (the format above) for this encoder: the Linear weights of
+    /// the layers quantised to int8 with a scale per output, everything else rounded to f16.
+    /// The bytes depend on the weights only, so a conversion always gives the same file.
     pub fn to_bytes(&self) -> Result<Vec<u8>, MiniLmError> {
-        let mut store = BurnpackStore::from_bytes(None)
-            .with_to_adapter(HalfPrecisionAdapter::new().chain(ForgetParamIds))
-            .metadata("model", "all-MiniLM-L6-v2 without word embeddings");
-        self.save_into(&mut store)
-            .map_err(|e| MiniLmError::Model(e.to_string()))?;
-        let bytes = store
-            .get_bytes()
-            .map_err(|e| MiniLmError::Model(e.to_string()))?;
+        let pack = |e: burn::store::burn_pack::Error| MiniLmError::Model(e.to_string());
+        let mut tensors = Vec::new();
+        for tensor in self.collect(None, None, false) {
+            let name = tensor.name.clone();
+            let data = bridge::into_data(tensor).map_err(pack)?;
+            if Self::stored_as_int8(&name) && data.rank() == 2 {
+                let (values, scales) = quantize_columns(&data)
+                    .map_err(|m| MiniLmError::Model(format!("{name}: {m}")))?;
+                let scale_name = format!("{name}{}", Self::SCALE_SUFFIX);
+                tensors.push(bridge::from_data(scales, scale_name, None));
+                tensors.push(bridge::from_data(values, name, None));
+            } else {
+                // No parameter ids: they are random per process and only matter to resume
+                // training.
+                tensors.push(bridge::from_data(
+                    data.convert_dtype(DType::F16),
+                    name,
+                    None,
+                ));
+            }
+        }
+        let bytes = PackWriter::new(tensors)
+            .with_metadata("format", Self::FORMAT)
+            .with_metadata("model", "all-MiniLM-L6-v2 without word embeddings")
+            .into_bytes()
+            .map_err(pack)?;
         Ok(bytes.to_vec())
     }
 }
 
-/// Drops the parameter ids from saved tensors. They are random per process and only matter to
-/// resume training; without them a conversion gives the same bytes every time, so the
-/// committed files can be checked against a fresh conversion.
-#[derive(Clone, Debug)]
-struct ForgetParamIds;
-
-impl ModuleAdapter for ForgetParamIds {
-    fn adapt(&self, mut tensor: PackTensor, _ctx: ModuleContext<'_>) -> PackTensor {
-        tensor.param_id = None;
-        tensor
+/// A `[rows, cols]` f32 matrix as int8 `[rows, cols]` and f32 `[cols]` scales, symmetric per
+/// column: `scale[c] = max_r |m[r, c]| / 127`, `q = round(m / scale)`. Columns are the outputs
+/// of a burn Linear weight.
+fn quantize_columns(matrix: &TensorData) -> Result<(TensorData, TensorData), String> {
+    let [rows, cols] = matrix.shape().dims::<2>();
+    let m: Vec<f32> = matrix
+        .clone()
+        .try_into_vec_as::<f32>()
+        .map_err(|e| format!("{e:?}"))?;
+    let mut max = vec![0f32; cols];
+    for row in m.chunks_exact(cols) {
+        for (mx, v) in max.iter_mut().zip(row) {
+            *mx = mx.max(v.abs());
+        }
     }
-
-    fn clone_box(&self) -> Box<dyn ModuleAdapter> {
-        Box::new(self.clone())
+    let mut scales: Vec<f32> = max.iter().map(|m| m / 127.0).collect();
+    if std::env::var("COMA_INT8_MSE").is_ok() {
+        // TEMP experiment: per column, the clipping of the largest value that minimises the
+        // squared error.
+        for (c, scale) in scales.iter_mut().enumerate() {
+            let column: Vec<f32> = (0..rows).map(|r| m[r * cols + c]).collect();
+            let error = |s: f32| -> f64 {
+                if s == 0.0 {
+                    return 0.0;
+                }
+                column
+                    .iter()
+                    .map(|v| {
+                        let q = (v / s).round().clamp(-127.0, 127.0);
+                        ((q * s - v) as f64).powi(2)
+                    })
+                    .sum()
+            };
+            let base = *scale;
+            let mut best = (error(base), base);
+            for k in 1..=40 {
+                let s = base * (1.0 - k as f32 * 0.0125);
+                let e = error(s);
+                if e < best.0 {
+                    best = (e, s);
+                }
+            }
+            *scale = best.1;
+        }
     }
+    // An all-zero column keeps scale 0; dividing by it would give NaN.
+    let inv: Vec<f32> = scales
+        .iter()
+        .map(|&s| if s > 0.0 { 1.0 / s } else { 0.0 })
+        .collect();
+    let q: Vec<i8> = m
+        .chunks_exact(cols)
+        .flat_map(|row| {
+            row.iter()
+                .zip(&inv)
+                .map(|(v, i)| (v * i).round().clamp(-127.0, 127.0) as i8)
+        })
+        .collect();
+    Ok((
+        TensorData::new(q, [rows, cols]),
+        TensorData::new(scales, [cols]),
+    ))
+}
+
+/// The f32 values of an int8 `[rows, cols]` matrix with `[cols]` scales (the inverse of
+/// [`quantize_columns`]), checking the shapes and that every scale is finite and ≥ 0.
+fn dequantize_columns(values: &TensorData, scales: &TensorData) -> Result<Vec<f32>, String> {
+    let shape = values.shape().to_vec();
+    let &[_, cols] = shape.as_slice() else {
+        return Err(format!("int8 tensor of shape {shape:?}, expected a matrix"));
+    };
+    if scales.shape().to_vec() != [cols] || scales.dtype() != DType::F32 {
+        return Err(format!(
+            "scales are {:?} {:?}, expected F32 [{cols}]",
+            scales.dtype(),
+            scales.shape()
+        ));
+    }
+    let scales: Vec<f32> = scales.iter::<f32>().collect();
+    if let Some(bad) = scales.iter().position(|s| !s.is_finite() || *s < 0.0) {
+        return Err(format!("scale {bad} is {}", scales[bad]));
+    }
+    let q: &[i8] = values.as_slice::<i8>().map_err(|e| format!("{e:?}"))?;
+    Ok(q.chunks_exact(cols)
+        .flat_map(|row| row.iter().zip(&scales).map(|(&q, &s)| q as f32 * s))
+        .collect())
 }
 
 /// Why an encoder could not be loaded.
@@ -433,7 +611,7 @@ impl std::fmt::Debug for SentenceEncoder {
 impl SentenceEncoder {
     /// Builds the encoder from the contents of its three files (no file system access, so it
     /// works in the browser): `vocab` is `minilm-vocab.txt`, `words` `minilm-words.i8`,
-    /// `model` `minilm.bpk`.
+    /// `model` `minilm-encoder.bpk`.
     pub fn from_bytes(
         vocab: &str,
         words: &[u8],
@@ -552,6 +730,9 @@ pub struct ConvertReport {
     pub model_bytes: u64,
     /// Largest absolute error of a dequantised word-embedding value.
     pub words_max_error: f32,
+    /// Largest absolute error of an encoder parameter as loaded back from the burnpack (int8
+    /// Linear weights, f16 rest).
+    pub model_max_error: f32,
 }
 
 /// The original checkpoint as one module, so that a single safetensors load fills both the
@@ -654,6 +835,10 @@ pub fn convert_minilm(model_dir: &Path, out_dir: &Path) -> anyhow::Result<Conver
     std::fs::write(&words_path, &words_bytes).with_context(|| words_path.display().to_string())?;
     let model_path = out_dir.join(MODEL_FILE);
     let model_bytes = checkpoint.encoder.to_bytes()?;
+    let model_max_error = max_difference(
+        &checkpoint.encoder,
+        &MiniLm::from_bytes(&model_bytes, &device)?,
+    )?;
     std::fs::write(&model_path, &model_bytes).with_context(|| model_path.display().to_string())?;
     Ok(ConvertReport {
         words_path,
@@ -661,7 +846,30 @@ pub fn convert_minilm(model_dir: &Path, out_dir: &Path) -> anyhow::Result<Conver
         model_path,
         model_bytes: model_bytes.len() as u64,
         words_max_error,
+        model_max_error,
     })
+}
+
+/// Largest absolute difference between the parameters of two encoders.
+fn max_difference(a: &MiniLm, b: &MiniLm) -> anyhow::Result<f32> {
+    let mut max = 0f32;
+    for (x, y) in a
+        .collect(None, None, false)
+        .iter()
+        .zip(b.collect(None, None, false).iter())
+    {
+        anyhow::ensure!(x.name == y.name, "{} vs {}", x.name, y.name);
+        let values = |t: &PackTensor| -> anyhow::Result<Vec<f32>> {
+            bridge::to_data(t)
+                .map_err(|e| anyhow::anyhow!("{e}"))?
+                .try_into_vec_as::<f32>()
+                .map_err(|e| anyhow::anyhow!("{e:?}"))
+        };
+        for (p, q) in values(x)?.iter().zip(&values(y)?) {
+            max = max.max((p - q).abs());
+        }
+    }
+    Ok(max)
 }
 
 /// Refuses a checkpoint whose HF `config.json` describes another shape than `config`.
@@ -695,4 +903,116 @@ fn check_hf_config(path: &Path, config: &MiniLmConfig) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn int8_columns_round_trip_within_half_a_step() {
+        let (rows, cols) = (6, 4);
+        let mut m: Vec<f32> = (0..rows * cols)
+            .map(|i| ((i as f32) * 0.71).sin() * (1.0 + i as f32))
+            .collect();
+        for r in 0..rows {
+            m[r * cols + 2] = 0.0; // an all-zero column keeps scale 0
+        }
+        let (q, scales) = quantize_columns(&TensorData::new(m.clone(), [rows, cols])).unwrap();
+        assert_eq!(q.dtype(), DType::I8);
+        assert_eq!(q.shape().to_vec(), [rows, cols]);
+        assert_eq!(scales.shape().to_vec(), [cols]);
+        let s: Vec<f32> = scales.iter::<f32>().collect();
+        assert_eq!(s[2], 0.0);
+        let back = dequantize_columns(&q, &scales).unwrap();
+        for (i, (got, want)) in back.iter().zip(&m).enumerate() {
+            let step = s[i % cols];
+            assert!(
+                (got - want).abs() <= step / 2.0 + 1e-6,
+                "{i}: {got} vs {want}"
+            );
+        }
+        // Each column's largest value is exact (±127 steps).
+        for c in 0..cols {
+            let max = (0..rows)
+                .map(|r| m[r * cols + c].abs())
+                .fold(0f32, f32::max);
+            let got = (0..rows)
+                .map(|r| back[r * cols + c].abs())
+                .fold(0f32, f32::max);
+            assert!((got - max).abs() < 1e-5, "column {c}: {got} vs {max}");
+        }
+    }
+
+    #[test]
+    fn bad_scales_are_errors() {
+        let q = TensorData::new(vec![1i8, -2, 3, 4], [2, 2]);
+        assert!(dequantize_columns(&q, &TensorData::new(vec![1f32, f32::NAN], [2])).is_err());
+        assert!(dequantize_columns(&q, &TensorData::new(vec![1f32, -1.0], [2])).is_err());
+        assert!(dequantize_columns(&q, &TensorData::new(vec![1f32, 1.0, 1.0], [3])).is_err());
+        assert!(dequantize_columns(&q, &TensorData::new(vec![1f64, 1.0], [2])).is_err());
+        let vector = TensorData::new(vec![1i8, 2], [2]);
+        assert!(dequantize_columns(&vector, &TensorData::new(vec![1f32, 1.0], [2])).is_err());
+        assert_eq!(
+            dequantize_columns(&q, &TensorData::new(vec![0.5f32, 2.0], [2])).unwrap(),
+            [0.5, -4.0, 1.5, 8.0]
+        );
+    }
+
+    /// A burnpack of the given tensors with or without the format tag.
+    fn pack(tensors: Vec<(&str, TensorData)>, tagged: bool) -> Vec<u8> {
+        let tensors = tensors
+            .into_iter()
+            .map(|(n, d)| bridge::from_data(d, n.to_string(), None))
+            .collect();
+        let mut writer = PackWriter::new(tensors);
+        if tagged {
+            writer = writer.with_metadata("format", MiniLm::FORMAT);
+        }
+        writer.into_bytes().unwrap().to_vec()
+    }
+
+    #[test]
+    fn malformed_encoder_files_are_errors() {
+        let device = Device::flex();
+        let bias = || TensorData::new(vec![0f32; 384], [384]);
+        let weight = || TensorData::new(vec![1i8; 4], [2, 2]);
+        let scale = || TensorData::new(vec![1f32; 2], [2]);
+        let cases = [
+            (
+                "untagged (the old minilm.bpk)",
+                pack(vec![("layers.0.output.bias", bias())], false),
+            ),
+            (
+                "int8 without scales",
+                pack(vec![("layers.0.output.weight", weight())], true),
+            ),
+            (
+                "scales without int8",
+                pack(vec![("layers.0.output.weight_scale", scale())], true),
+            ),
+            (
+                "int8 of the wrong shape",
+                pack(
+                    vec![
+                        ("layers.0.output.weight", weight()),
+                        ("layers.0.output.weight_scale", scale()),
+                    ],
+                    true,
+                ),
+            ),
+            (
+                "most tensors missing",
+                pack(vec![("layers.0.output.bias", bias())], true),
+            ),
+        ];
+        for (what, bytes) in cases {
+            let r = MiniLm::from_bytes(&bytes, &device);
+            assert!(
+                matches!(r, Err(MiniLmError::Model(_))),
+                "{what}: {:?}",
+                r.map(|_| ())
+            );
+        }
+    }
 }

@@ -169,8 +169,13 @@ pub fn train_vq(
         }
         let eval_due = done % config.eval_every == 0 || done == config.steps;
         if let Some(val) = val.as_ref().filter(|_| eval_due) {
-            let e =
-                reconstruction_errors(&model.valid(), val, &device.clone().without_autodiff(), 64)?;
+            let e = reconstruction_errors(
+                &model.valid(),
+                val,
+                &device.clone().without_autodiff(),
+                64,
+                usize::MAX,
+            )?;
             progress(&format!(
                 "step {done}: validation reconstruction error {:.1} mm root-aligned MPJPE, {:.1} mm with the root path integrated",
                 e.root_aligned_mm, e.global_mm
@@ -225,6 +230,7 @@ pub fn reconstruction_errors(
     set: &MotionSet,
     device: &Device,
     limit: usize,
+    layers: usize,
 ) -> Result<ReconstructionError> {
     let (mut global, mut aligned, mut count, mut motions) = (0.0, 0.0, 0usize, 0usize);
     for item in set.items.iter().take(limit) {
@@ -234,8 +240,18 @@ pub fn reconstruction_errors(
         }
         let frames = &item.features[..t];
         let x = batch_tensor(frames.iter().flatten().copied().collect(), 1, t, device);
+        // Only the first `layers` residual layers: what a decoder sees when the later layers
+        // are left out (quantisation dropout trained it for that).
+        let tokens: Vec<_> = model
+            .tokenize(x)
+            .into_iter()
+            .map(|mut part| {
+                part.truncate(layers.max(1));
+                part
+            })
+            .collect();
         let y: Vec<f32> = model
-            .reconstruct(x)
+            .decode(&tokens)
             .try_into_vec_as::<f32>()
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let recon: Vec<FeatureFrame> = y

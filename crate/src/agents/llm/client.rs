@@ -229,10 +229,12 @@ impl<T: Transport> LlmClient<T> {
         excerpt(text, self.config.api_key.as_ref().map(|k| k.expose()))
     }
 
-    /// After a 400/422 that blames the reply format sent at `level`, lowers what the server is
-    /// believed to support and says whether the request is worth re-sending.
+    /// After a 400/422 (or a 500: llama-cpp-python's server answers an unknown
+    /// `response_format` type with a validation error under status 500) that blames the reply
+    /// format sent at `level`, lowers what the server is believed to support and says whether
+    /// the request is worth re-sending.
     fn downgrade_for(&self, reply: &HttpReply, level: FormatLevel) -> bool {
-        if !matches!(reply.status, 400 | 422) {
+        if !matches!(reply.status, 400 | 422 | 500) {
             return false;
         }
         let Some(weaker) = level.weaker() else {

@@ -149,6 +149,11 @@ impl ReplyFormat {
                 "type": "json_schema",
                 "json_schema": {"name": name, "schema": schema, "strict": true},
             })),
+            // Servers that take no json_schema (llama-cpp-python) read a schema beside
+            // json_object and constrain the reply to it; others ignore the extra member.
+            (ReplyFormat::JsonSchema { schema, .. }, FormatLevel::JsonObject) => {
+                Some(json!({"type": "json_object", "schema": schema}))
+            }
             (_, FormatLevel::JsonObject) => Some(json!({"type": "json_object"})),
             _ => None,
         }
@@ -234,7 +239,7 @@ mod tests {
         );
         assert_eq!(
             schema.response_format(FormatLevel::JsonObject),
-            Some(json!({"type": "json_object"}))
+            Some(json!({"type": "json_object", "schema": {"type": "object"}}))
         );
         assert_eq!(schema.response_format(FormatLevel::Text), None);
         assert_eq!(

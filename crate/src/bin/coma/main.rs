@@ -134,7 +134,8 @@ enum Command {
         /// Residual transformer run folder.
         #[arg(long, default_value = "runs/res")]
         res: PathBuf,
-        /// Dataset whose Mean.npy/Std.npy normalised the training data.
+        /// Dataset whose Mean.npy/Std.npy normalised the training data (for the evaluator:
+        /// whose test split shows what rounding to f16 changes).
         #[arg(long, default_value = "data/bandai")]
         data: PathBuf,
         #[arg(long, default_value = "static/models")]
@@ -156,6 +157,9 @@ enum Command {
         /// At most this many motions.
         #[arg(long, default_value_t = 100000)]
         limit: usize,
+        /// Decode from the first N residual layers only (default: all).
+        #[arg(long)]
+        layers: Option<usize>,
     },
     /// The field's metrics on the test split (real motions, a retrieval baseline, SPAM) and
     /// the control probes; writes EVAL.md and eval.json.
@@ -411,7 +415,7 @@ enum TextCommand {
 enum ExportWhat {
     /// The three trained SPAM networks.
     Spam,
-    /// The trained evaluator.
+    /// The trained evaluator, rounded to f16.
     Evaluator,
     /// SPAM with random weights at the default sizes (configs/spam.json), for tests of the
     /// plumbing before trained weights exist; never the default model.
@@ -635,6 +639,77 @@ fn evaluate_agents(
         }
     }
     Ok(figures)
+}
+
+/// `coma export evaluator`: the run's weights rounded to f16 into `out`, and what the rounding
+/// changes on 224 random captioned test motions of `data` (when `data` and the sentence
+/// encoder in `out` are there).
+fn export_evaluator(
+    run: &std::path::Path,
+    data: &std::path::Path,
+    out: &std::path::Path,
+) -> Result<()> {
+    use burn::config::Config;
+    use coma::eval::evaluator::{agreement, Evaluator};
+    let device = burn::tensor::Device::flex();
+    let cfg = coma::train::evaluator::EvaluatorTrainingConfig::load(run.join("config.json"))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", run.join("config.json").display()))?;
+    let original = Evaluator::load_weights(&cfg.model, &run.join("evaluator.bpk"), &device)?;
+    std::fs::create_dir_all(out)?;
+    cfg.model
+        .save(out.join("evaluator.json"))
+        .map_err(|e| anyhow::anyhow!("writing evaluator.json: {e}"))?;
+    let weights = out.join("evaluator.bpk");
+    let bytes = original.to_f16_bytes()?;
+    std::fs::write(&weights, &bytes).with_context(|| weights.display().to_string())?;
+    let (half, config) = Evaluator::load(out, &device)?;
+    println!(
+        "exported the evaluator into {} (f16, {} bytes)",
+        out.display(),
+        bytes.len()
+    );
+
+    let Ok(test) = coma::train::motions::MotionSet::load(data, coma::dataset::Split::Test) else {
+        println!("no test split in {}: f16 not compared", data.display());
+        return Ok(());
+    };
+    let Ok(text) = coma::text::minilm::SentenceEncoder::from_dir(out, &device) else {
+        println!("no sentence encoder in {}: f16 not compared", out.display());
+        return Ok(());
+    };
+    // As one repetition of `coma eval`: motions in a random order (neighbouring test motions
+    // are windows of the same take, which would crowd a batch of 32) with a random caption.
+    let mut rng = coma::rng::Rng::new(0);
+    let mut items: Vec<_> = test
+        .items
+        .iter()
+        .filter(|i| !i.captions.is_empty())
+        .collect();
+    rng.shuffle(&mut items);
+    items.truncate(224);
+    let motions: Vec<&[coma::features::FeatureFrame]> =
+        items.iter().map(|i| i.features.as_slice()).collect();
+    let captions: Vec<&str> = items
+        .iter()
+        .map(|i| i.captions[rng.below(i.captions.len())].as_str())
+        .collect();
+    let sentences: Vec<_> = captions.chunks(64).flat_map(|c| text.encode(c)).collect();
+    let a = agreement(&original, &half, &config, &motions, &sentences, &device);
+    let [full, rounded] = a.r_precision;
+    println!(
+        "f16 against the run's weights on {} random test motions and captions: alignment \
+         scores (0-100) differ by at most {:.4} (mean {:.5}); R-precision top-1 {:.4} -> {:.4}, \
+         top-3 {:.4} -> {:.4}; {} captions change their nearest motion",
+        a.pairs,
+        a.max_score_difference,
+        a.mean_score_difference,
+        full[0],
+        rounded[0],
+        full[2],
+        rounded[2],
+        a.changed_nearest
+    );
+    Ok(())
 }
 
 fn evaluate(
@@ -1136,24 +1211,10 @@ fn run(cli: Cli) -> Result<()> {
         Command::Export {
             what: ExportWhat::Evaluator,
             evaluator,
+            data,
             out,
             ..
-        } => {
-            use burn::config::Config;
-            let cfg = coma::train::evaluator::EvaluatorTrainingConfig::load(
-                evaluator.join("config.json"),
-            )
-            .map_err(|e| anyhow::anyhow!("{}: {e}", evaluator.join("config.json").display()))?;
-            std::fs::create_dir_all(&out)?;
-            cfg.model
-                .save(out.join("evaluator.json"))
-                .map_err(|e| anyhow::anyhow!("writing evaluator.json: {e}"))?;
-            let from = evaluator.join("evaluator.bpk");
-            std::fs::copy(&from, out.join("evaluator.bpk"))
-                .with_context(|| format!("copying {}", from.display()))?;
-            coma::eval::evaluator::Evaluator::load(&out, &burn::tensor::Device::flex())?;
-            println!("exported the evaluator into {}", out.display());
-        }
+        } => export_evaluator(&evaluator, &data, &out)?,
         Command::Export {
             vq,
             base,
@@ -1200,6 +1261,7 @@ fn run(cli: Cli) -> Result<()> {
             data,
             split,
             limit,
+            layers,
         } => {
             use burn::config::Config;
             use burn::module::Module;
@@ -1218,10 +1280,11 @@ fn run(cli: Cli) -> Result<()> {
                 .try_load_file(&weights)
                 .map_err(|e| anyhow::anyhow!("cannot load {}: {e:?}", weights.display()))?;
             let set = coma::train::motions::MotionSet::load(&data, split)?;
-            let e = coma::train::vq::reconstruction_errors(&model, &set, &device, limit)?;
+            let layers = layers.unwrap_or(cfg.model.layers);
+            let e = coma::train::vq::reconstruction_errors(&model, &set, &device, limit, layers)?;
             println!(
-                "{} motions of the {:?} split: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned)",
-                e.motions, split, e.global_mm, e.root_aligned_mm
+                "{} motions of the {:?} split, {layers} of {} layers: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned)",
+                e.motions, split, cfg.model.layers, e.global_mm, e.root_aligned_mm
             );
         }
         Command::Train {
