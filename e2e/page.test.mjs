@@ -1,6 +1,7 @@
-// End-to-end test of the page in headless Chromium: load, generate with no LLM, watch the
-// canvas move, share the link and rebuild the same motion from it in a fresh page, download a
-// BVH that our own reader parses, and take the screenshots under docs/.
+// End-to-end test of the page in headless Chromium: load, generate with no LLM (the built-in
+// planner and the whole pipeline), watch the canvas move, share the link and rebuild the same
+// motion from it in a fresh page, download a BVH that our own reader parses, plan and run a
+// three-segment prompt whose link rebuilds it too, and take the screenshots under docs/.
 //
 // Needs: the built page in DIST (default ../dist), the coma binary in COMA (serves the page and
 // reads the BVH), /usr/bin/chromium.
@@ -44,10 +45,11 @@ async function waitForServer() {
 async function open(context, url) {
   const page = await context.newPage();
   const problems = [];
-  const stats = { bytes: 0 };
+  const stats = { bytes: 0, outside: [] };
   page.on("console", (m) => { if (m.type() === "error") problems.push(`console: ${m.text()}`); });
   page.on("pageerror", (e) => problems.push(`uncaught: ${e.message}`));
   page.on("worker", (w) => w.on("console", (m) => { if (m.type() === "error") problems.push(`worker console: ${m.text()}`); }));
+  page.on("request", (req) => { if (!req.url().startsWith(BASE)) stats.outside.push(req.url()); });
   page.on("requestfinished", async (req) => {
     try { const s = await req.sizes(); stats.bytes += s.responseBodySize + s.responseHeadersSize; } catch {}
   });
@@ -89,6 +91,8 @@ test("the page generates, plays, shares, rebuilds and exports a motion", { timeo
     const status = await page.locator("#status").textContent();
     console.log(`generated ${frames} frames in ${((Date.now() - started) / 1000).toFixed(1)} s in the page (${status})`);
     assert.ok(Math.abs(frames - 196) <= 4, `asked 196 frames, got ${frames}`);
+    assert.equal(await page.locator(".segment").count(), 1, "one segment for one movement");
+    console.log(`steps: ${(await page.locator("#steps li").allTextContents()).join(" | ")}`);
 
     // The motion plays: the canvas changes over time.
     const a = await canvasPixels(page);
@@ -125,7 +129,73 @@ test("the page generates, plays, shares, rebuilds and exports a motion", { timeo
     await download.saveAs(bvh);
     execFileSync(COMA, ["convert", bvh, join(dir, "motion.json")]);
 
+    // A prompt of three movements: three segments, a left-arm edit, and a link that rebuilds
+    // the same joints.
+    await page.fill("#prompt", "A person walks forward waving the left hand, then turns right and bows");
+    await page.fill("#seconds", "");
+    await page.locator("#seconds").dispatchEvent("change");
+    const runStarted = Date.now();
+    await page.click("#generate");
+    await page.waitForFunction((h) => {
+      const v = document.querySelector(".viewer");
+      return v && v.dataset.jointsHash && v.dataset.jointsHash !== h
+        && document.querySelectorAll(".segments:not(.preview) .segment").length > 0
+        && !document.querySelector("#generate").disabled;
+    }, hash, { timeout: LOAD_TIMEOUT });
+    const runFrames = Number(await page.locator(".viewer").getAttribute("data-frames"));
+    const steps = await page.locator("#steps li").allTextContents();
+    console.log(`ran 3 segments: ${runFrames} frames in ${((Date.now() - runStarted) / 1000).toFixed(1)} s in the page, ${steps.length} steps (${await page.locator("#status").textContent()})`);
+    assert.equal(await page.locator(".segment").count(), 3, "three segments on the timeline");
+    const texts = await page.locator(".segment .segment-text").allTextContents();
+    assert.match(texts[0], /walks forward/);
+    assert.match(texts[2], /bows/);
+    const leftArm = await page.locator('.part-edit[data-part="left arm"]').allTextContents();
+    assert.ok(leftArm.some((t) => /left hand/.test(t)), `a left-arm edit: ${leftArm}`);
+    assert.ok(steps.some((l) => /left arm/.test(l)) && steps.some((l) => /blended/.test(l)), steps.join(" | "));
+    const runHash = await page.locator(".viewer").getAttribute("data-joints-hash");
+    await page.click("#share");
+    const runLink = await page.locator("#share-link").inputValue();
+    const fourth = await open(await browser.newContext({ viewport: { width: 1280, height: 800 } }), runLink);
+    await fourth.page.waitForFunction((h) => document.querySelector(".viewer")?.dataset.jointsHash === h, runHash, { timeout: LOAD_TIMEOUT });
+    assert.equal(await fourth.page.locator(".segment").count(), 3, "the link keeps the plan");
+    assert.ok(await fourth.page.locator('.part-edit[data-part="left arm"]').count() > 0);
+    const history = await page.locator("#history li").allTextContents();
+    assert.ok(history.some((l) => /^left arm ←/.test(l)) && history.some((l) => /^blend/.test(l)), history.join(" | "));
+    assert.deepEqual(await fourth.page.locator("#history li").allTextContents(), history, "the link keeps the edit history");
+
+    // An LLM that cannot be reached: the built-in planner's plan is used, the notes say why,
+    // and the API key stays out of the link and the page.
+    const KEY = "sk-e2e-never-shown-0123";
+    const llm = fourth.page;
+    await llm.click("#settings-summary");
+    await llm.fill("#llm-base", "http://127.0.0.1:9/v1");
+    await llm.fill("#llm-model", "no-such-model");
+    await llm.fill("#llm-key", KEY);
+    await llm.click("#settings-save");
+    await llm.click("#settings-summary");
+    await llm.fill("#prompt", "A person walks forward waving the left hand, then turns right and bows");
+    await llm.selectOption("#rounds", "0");
+    // Another seed, so the new motion tells itself apart from the link's.
+    await llm.fill("#seed", "5");
+    await llm.locator("#seed").dispatchEvent("change");
+    await llm.click("#generate");
+    await llm.waitForFunction((h) => {
+      const v = document.querySelector(".viewer");
+      return v && v.dataset.jointsHash !== h && !document.querySelector("#generate").disabled;
+    }, runHash, { timeout: LOAD_TIMEOUT });
+    const notes = await llm.locator("#notes li").allTextContents();
+    console.log(`unreachable LLM: ${notes.length} notes, e.g. ${notes[0]}`);
+    assert.ok(notes.some((n) => /could not reach/.test(n) && /CORS/.test(n)), notes.join(" | "));
+    assert.equal(await llm.locator(".segment").count(), 3, "the built-in planner's three segments");
+    await llm.click("#share");
+    const llmLink = await llm.locator("#share-link").inputValue();
+    assert.ok(!llmLink.includes(KEY) && !(await llm.content()).includes(KEY), "the key is shown");
+    assert.deepEqual([...new Set(fourth.stats.outside)], ["http://127.0.0.1:9/v1/chat/completions"]);
     for (const p of [first, second, third]) {
+      assert.deepEqual(p.stats.outside, [], "a page without LLM settings sent something out");
+    }
+
+    for (const p of [first, second, third, fourth]) {
       assert.deepEqual(p.problems, [], "errors in the browser console");
     }
   } finally {

@@ -1,15 +1,16 @@
 //! The page: shared state in context, the worker's replies turned into state, and the layout
-//! of the components (prompt, viewer, timeline, toolbar, about).
+//! of the components (prompt, steps, viewer, timeline, toolbar, settings, about).
 
 use crate::client::Client;
 use crate::history::History;
-use crate::messages::{Backend, Reply, Request};
-use crate::take::{segments_from_plan, Segment, Take};
+use crate::messages::{Backend, LlmSettings, Reply, Request};
+use crate::take::{plan_from_link, Take};
 use crate::ui::{
-    about::About, prompt::PromptBox, status::StatusBar, timeline::Timeline, toolbar::Toolbar,
-    viewer::Viewer,
+    about::About, prompt::PromptBox, settings::Settings, status::StatusBar, steps::Steps,
+    timeline::Timeline, toolbar::Toolbar, viewer::Viewer,
 };
-use coma::share::{self, Edit, EditKind};
+use coma::agents::plan::Plan;
+use coma::share::{self, Edit};
 use leptos::prelude::*;
 
 /// Undo keeps this many states.
@@ -23,6 +24,8 @@ pub struct ModelInfo {
     pub note: Option<String>,
     pub bytes: u64,
     pub millis: f64,
+    /// What did not load, and what the page does without it.
+    pub missing: Vec<String>,
 }
 
 /// A line for the user: what happened, or what went wrong and what to do.
@@ -35,8 +38,8 @@ pub struct Status {
 /// What a request in flight will become when its motion arrives.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Pending {
-    /// A new take from the prompt.
-    Generate { prompt: String, seed: u64 },
+    /// A new take from the prompt, by the whole pipeline.
+    Run { prompt: String, seed: u64 },
     /// An edit of the current take.
     Edit(Edit),
     /// A take rebuilt from a share link.
@@ -59,6 +62,12 @@ pub struct AppState {
     pub generate_millis: RwSignal<Option<f64>>,
     /// A link made with another model, waiting for the user to regenerate it.
     pub foreign_link: RwSignal<Option<share::SharedMotion>>,
+    /// The progress lines of the last run, one per planner or pipeline step.
+    pub steps: RwSignal<Vec<String>>,
+    /// The plan of the run in flight, shown on the timeline before its motion exists.
+    pub preview: RwSignal<Option<Plan>>,
+    /// The LLM endpoint of the Settings panel (empty: no LLM, nothing is sent anywhere).
+    pub settings: RwSignal<LlmSettings>,
     pub client: StoredValue<Option<Client>, LocalStorage>,
 }
 
@@ -102,6 +111,9 @@ impl AppState {
         });
         match sent {
             Ok(()) => {
+                if matches!(pending, Pending::Run { .. }) {
+                    self.steps.set(Vec::new());
+                }
                 self.pending.set(Some(pending));
                 self.progress.set(Some(("working".into(), 0, 1)));
             }
@@ -110,7 +122,7 @@ impl AppState {
     }
 
     /// Writes the current take into the URL fragment, so the address is the share link.
-    fn publish(&self) {
+    pub fn publish(&self) {
         let (Some(take), Some(model)) = (self.take(), self.model.get_untracked()) else {
             return;
         };
@@ -142,12 +154,18 @@ fn on_reply(state: AppState, reply: Reply) {
             note,
             bytes,
             millis,
+            missing,
         } => {
             state.progress.set(None);
             state.say(format!(
-                "Model {model_id} loaded ({:.1} MB in {:.1} s). Type a prompt and press Generate.",
+                "Model {model_id} loaded ({:.1} MB in {:.1} s){}. Type a prompt and press Generate.",
                 bytes as f64 / 1e6,
-                millis / 1000.0
+                millis / 1000.0,
+                if missing.is_empty() {
+                    String::new()
+                } else {
+                    format!("; not loaded: {}", missing.join("; "))
+                }
             ));
             state.model.set(Some(ModelInfo {
                 id: model_id,
@@ -155,66 +173,103 @@ fn on_reply(state: AppState, reply: Reply) {
                 note,
                 bytes,
                 millis,
+                missing,
             }));
             open_link(state);
         }
-        Reply::Motion { motion, millis } => {
+        Reply::Plan { plan } => match crate::planning::parse_plan(&plan) {
+            Ok(plan) => state.preview.set(Some(plan)),
+            Err(e) => state.fail(format!("the worker's plan does not read: {e}")),
+        },
+        Reply::Step { line, done, total } => {
+            state.progress.set(Some((line.clone(), done, total)));
+            state.steps.update(|s| s.push(line));
+        }
+        Reply::Run {
+            motion,
+            plan,
+            history,
+            notes,
+            scores,
+            millis,
+        } => {
+            state.progress.set(None);
+            state.preview.set(None);
+            let Some(Pending::Run { prompt, seed }) = state.pending.get_untracked() else {
+                state.pending.set(None);
+                return;
+            };
+            state.pending.set(None);
+            let plan = match crate::planning::parse_plan(&plan) {
+                Ok(plan) => plan,
+                Err(e) => return state.fail(format!("the worker's plan does not read: {e}")),
+            };
+            state.generate_millis.set(Some(millis));
+            let mut take = Take::new(motion, prompt, seed, history, Some(plan), Vec::new());
+            take.scores = scores;
+            let summary = match notes.first() {
+                None => format!("Done in {:.1} s.", millis / 1000.0),
+                Some(first) => format!(
+                    "Done in {:.1} s. Note: {first}{}",
+                    millis / 1000.0,
+                    if notes.len() > 1 {
+                        format!(" (and {} more under Steps)", notes.len() - 1)
+                    } else {
+                        String::new()
+                    }
+                ),
+            };
+            take.notes = notes;
+            show(state, take);
+            state.say(summary);
+        }
+        Reply::Motion {
+            motion,
+            millis,
+            notes,
+        } => {
             state.progress.set(None);
             let pending = state.pending.get_untracked();
             state.pending.set(None);
-            let previous = state.take();
-            let frames = motion.joints.len();
             let take = match pending {
-                Some(Pending::Generate { prompt, seed }) => {
-                    state.generate_millis.set(Some(millis));
-                    Take {
-                        motion,
-                        segments: vec![Segment {
-                            text: prompt.clone(),
-                            from: 0,
-                            to: frames,
-                        }],
-                        edits: vec![Edit {
-                            kind: EditKind::Generate,
-                            text: prompt.clone(),
-                            from_frame: 0,
-                            to_frame: frames as u32,
-                            parts: 0,
-                            seed,
-                        }],
-                        prompt,
-                        seed,
-                    }
-                }
-                Some(Pending::Edit(edit)) => match previous {
+                Some(Pending::Edit(edit)) => match state.take() {
                     Some(mut take) => {
                         take.motion = motion;
                         take.edits.push(edit);
+                        // The review scored the motion before this edit.
+                        take.scores.clear();
                         take
                     }
                     None => return state.fail("there was no motion to edit"),
                 },
-                Some(Pending::Link(link)) => Take {
-                    segments: segments_from_plan(&link.plan, &link.prompt, frames),
-                    motion,
-                    prompt: link.prompt,
-                    seed: link.seed,
-                    edits: link.history,
-                },
-                None => return,
+                Some(Pending::Link(link)) => {
+                    let (plan, legacy) =
+                        plan_from_link(&link.plan, &link.prompt, motion.joints.len());
+                    Take::new(motion, link.prompt, link.seed, link.history, plan, legacy)
+                }
+                Some(Pending::Run { .. }) | None => return,
             };
-            state.history.update(|h| h.push(Some(take)));
-            state.frame.set(0.0);
-            state.playing.set(true);
-            state.publish();
-            state.say(format!("Done in {:.1} s.", millis / 1000.0));
+            show(state, take);
+            state.say(match notes.first() {
+                None => format!("Done in {:.1} s.", millis / 1000.0),
+                Some(note) => format!("Done in {:.1} s. Note: {note}", millis / 1000.0),
+            });
         }
         Reply::Error { message } => {
             state.progress.set(None);
             state.pending.set(None);
+            state.preview.set(None);
             state.fail(message);
         }
     }
+}
+
+/// Makes `take` the current state (undoable), plays it and puts it in the address.
+fn show(state: AppState, take: Take) {
+    state.history.update(|h| h.push(Some(take)));
+    state.frame.set(0.0);
+    state.playing.set(true);
+    state.publish();
 }
 
 /// Opens the share link in the URL, if there is one.
@@ -242,6 +297,7 @@ fn open_link(state: AppState) {
                 state.request(
                     Request::Decode {
                         tokens: link.tokens.clone(),
+                        plan: Some(link.plan.clone()),
                     },
                     Pending::Link(link),
                 );
@@ -266,6 +322,9 @@ pub fn App() -> impl IntoView {
         speed: RwSignal::new(1.0),
         generate_millis: RwSignal::new(None),
         foreign_link: RwSignal::new(None),
+        steps: RwSignal::new(Vec::new()),
+        preview: RwSignal::new(None),
+        settings: RwSignal::new(crate::ui::settings::stored()),
         client: StoredValue::new_local(None),
     };
     provide_context(state);
@@ -276,11 +335,13 @@ pub fn App() -> impl IntoView {
     view! {
         <header>
             <h1>"CoMA in the browser"</h1>
+            <Settings/>
             <About/>
         </header>
         <main>
             <section class="left">
                 <PromptBox/>
+                <Steps/>
                 <Timeline/>
                 <Toolbar/>
             </section>

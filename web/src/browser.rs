@@ -90,3 +90,33 @@ pub fn has_webgpu() -> bool {
         .and_then(|w| js_sys::Reflect::get(&w.navigator(), &"gpu".into()).ok())
         .is_some_and(|gpu| !gpu.is_undefined() && !gpu.is_null())
 }
+
+fn local_storage() -> Result<web_sys::Storage, String> {
+    window()?
+        .local_storage()
+        .map_err(|e| format!("{e:?}"))?
+        .ok_or_else(|| "this browser keeps no local storage for the page".to_string())
+}
+
+/// The value stored under `key` in the browser's local storage, if any.
+pub fn stored(key: &str) -> Option<String> {
+    local_storage().ok()?.get_item(key).ok()?
+}
+
+/// Stores `value` under `key` in the browser's local storage (`None` removes it).
+pub fn store(key: &str, value: Option<&str>) -> Result<(), String> {
+    let storage = local_storage()?;
+    match value {
+        Some(v) => storage.set_item(key, v),
+        None => storage.remove_item(key),
+    }
+    // The error may hold the value (the API key): say only that it failed.
+    .map_err(|_| "the browser refused to store the settings (private mode or full storage?)".into())
+}
+
+/// The page's origin (`https://host:port`), as a server's CORS setting names it.
+pub fn origin() -> String {
+    window()
+        .and_then(|w| w.location().origin().map_err(|e| format!("{e:?}")))
+        .unwrap_or_default()
+}

@@ -2,7 +2,7 @@
 //! Blender), JSON (joints per frame with the prompt and the plan) and NPY (HumanML3D's 263
 //! features, or the (T, 22, 3) joints).
 
-use crate::take::{plan_json, Take};
+use crate::take::Take;
 use coma::features::{features_to_npy, joints_to_npy, FeatureFrame, FEATURE_DIM, FPS};
 use coma::skeleton::Pose;
 
@@ -72,7 +72,14 @@ pub fn export(take: &Take, format: Format) -> Result<Vec<u8>, String> {
             json["prompt"] = take.prompt.clone().into();
             json["seed"] = take.seed.into();
             json["plan"] =
-                serde_json::from_str(&plan_json(&take.segments)).unwrap_or(serde_json::Value::Null);
+                serde_json::from_str(&take.plan_json()).unwrap_or(serde_json::Value::Null);
+            // Where each segment lies in the frames, which the plan itself (in seconds)
+            // does not say exactly.
+            json["segments"] = take
+                .segments
+                .iter()
+                .map(|s| serde_json::json!({"text": s.text, "from": s.from, "to": s.to}))
+                .collect();
             Ok(json.to_string().into_bytes())
         }
         Format::FeaturesNpy => {
@@ -98,7 +105,7 @@ pub fn export(take: &Take, format: Format) -> Result<Vec<u8>, String> {
 mod tests {
     use super::*;
     use crate::messages::Motion;
-    use crate::take::Segment;
+    use crate::take::segments_from_plan;
 
     fn take() -> Take {
         // A standing pose from the reference skeleton, swaying.
@@ -119,21 +126,18 @@ mod tests {
                 })
             })
             .collect();
-        Take {
-            motion: Motion {
+        Take::new(
+            Motion {
                 tokens: vec![vec![vec![1, 2]; 4]; 4],
                 features: vec![vec![0.5; FEATURE_DIM]; 9],
                 joints,
             },
-            prompt: "a person sways".into(),
-            seed: 3,
-            edits: vec![],
-            segments: vec![Segment {
-                text: "a person sways".into(),
-                from: 0,
-                to: 10,
-            }],
-        }
+            "a person sways".into(),
+            3,
+            vec![],
+            None,
+            segments_from_plan("", "a person sways", 10),
+        )
     }
 
     #[test]
@@ -147,6 +151,13 @@ mod tests {
         assert_eq!(json["frames"].as_array().unwrap().len(), 10);
         assert_eq!(json["prompt"], "a person sways");
         assert_eq!(json["plan"]["segments"][0]["to"], 10);
+        assert_eq!(json["segments"][0]["to"], 10);
+        // A planned take exports the planner's whole plan.
+        let mut planned = t.clone();
+        planned.plan = Some(coma::agents::planner::offline::plan("a person bows", None));
+        let json: serde_json::Value =
+            serde_json::from_slice(&export(&planned, Format::Json).unwrap()).unwrap();
+        assert_eq!(json["plan"]["segments"][0]["base"], "a person bows");
         let f = coma::npy::NpyArray::from_bytes(&export(&t, Format::FeaturesNpy).unwrap()).unwrap();
         assert_eq!(f.shape, vec![9, FEATURE_DIM]);
         let j = coma::npy::NpyArray::from_bytes(&export(&t, Format::JointsNpy).unwrap()).unwrap();

@@ -1,15 +1,34 @@
 //! A take: one state of the page's motion (tokens, joints and features) with what made it
-//! (prompt, seed, the edits so far, the segments), as undo keeps it and a share link carries it.
+//! (prompt, seed, plan, the edits so far, the segments), as undo keeps it and a share link
+//! carries it.
 
-use crate::messages::Motion;
-use coma::share::{Edit, SharedMotion};
+use crate::messages::{Motion, SegmentScores};
+use coma::agents::plan::Plan;
+use coma::model::motion_model::frames_for_seconds;
+use coma::share::{Edit, EditKind, SharedMotion};
 
-/// A stretch of the motion with its own text, in frames at 20 fps.
+/// Frames per token step: segments start and end on whole steps.
+const STEP_FRAMES: usize = 4;
+
+/// A stretch of the motion with its own text, in frames at 20 fps, and what the plan asked
+/// of it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Segment {
     pub text: String,
     pub from: usize,
     pub to: usize,
+    /// The whole-body motion generated first ("" when the take has no plan).
+    pub base: String,
+    /// `(body part, instruction)` for the parts with their own edit.
+    pub parts: Vec<(String, String)>,
+    /// The root path, described ("a circle, clockwise").
+    pub path: Option<String>,
+}
+
+impl Segment {
+    pub fn seconds(&self) -> f64 {
+        (self.to - self.from) as f64 / 20.0
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -18,13 +37,54 @@ pub struct Take {
     pub prompt: String,
     pub seed: u64,
     pub edits: Vec<Edit>,
+    /// The plan the run followed; `None` for a take from an older link without one.
+    pub plan: Option<Plan>,
     pub segments: Vec<Segment>,
+    /// What the planner and the run changed, dropped or could not do.
+    pub notes: Vec<String>,
+    /// The review's scores per segment (cleared by an edit, which they no longer describe).
+    pub scores: Vec<SegmentScores>,
 }
 
 impl Take {
+    /// A take of `motion` made by following `plan` (its segments come from the plan), or with
+    /// `legacy` segments when there is no plan.
+    pub fn new(
+        motion: Motion,
+        prompt: String,
+        seed: u64,
+        edits: Vec<Edit>,
+        plan: Option<Plan>,
+        legacy: Vec<Segment>,
+    ) -> Take {
+        let frames = motion.joints.len();
+        let segments = match &plan {
+            Some(plan) => plan_segments(plan, frames),
+            None => legacy,
+        };
+        Take {
+            motion,
+            prompt,
+            seed,
+            edits,
+            plan,
+            segments,
+            notes: Vec::new(),
+            scores: Vec::new(),
+        }
+    }
+
     /// Frames of the motion.
     pub fn frames(&self) -> usize {
         self.motion.joints.len()
+    }
+
+    /// The plan as JSON, as links and the worker read it.
+    pub fn plan_json(&self) -> String {
+        match &self.plan {
+            Some(plan) => serde_json::to_string(plan).unwrap_or_default(),
+            None => plan_json(&self.segments),
+        }
     }
 
     /// What a share link of this take carries.
@@ -33,14 +93,54 @@ impl Take {
             model_id,
             seed: self.seed,
             prompt: self.prompt.clone(),
-            plan: plan_json(&self.segments),
+            plan: self.plan_json(),
             history: self.edits.clone(),
             tokens: self.motion.tokens.clone(),
         }
     }
 }
 
-/// The segments as the plan a link carries.
+/// The plan's segments laid end to end over a motion of `frames` frames, each as long as
+/// one generation of its seconds (whole token steps), as the pipeline's
+/// `segment_ranges` lays them; a motion still being made (`frames` 0) gets them all.
+pub fn plan_segments(plan: &Plan, frames: usize) -> Vec<Segment> {
+    let lengths: Vec<usize> = plan
+        .segments
+        .iter()
+        .map(|s| frames_for_seconds(s.seconds).div_ceil(STEP_FRAMES) * STEP_FRAMES)
+        .collect();
+    let total = if frames == 0 {
+        lengths.iter().sum()
+    } else {
+        frames
+    };
+    let mut start = 0;
+    plan.segments
+        .iter()
+        .zip(lengths)
+        .map(|(s, len)| {
+            let (from, to) = (start.min(total), (start + len).min(total));
+            start += len;
+            Segment {
+                text: s.text.chars().take(500).collect(),
+                from,
+                to,
+                base: s.base.chars().take(500).collect(),
+                parts: s
+                    .parts
+                    .edits()
+                    .into_iter()
+                    .map(|(p, t)| (p.name().to_string(), t.chars().take(500).collect()))
+                    .collect(),
+                path: s.trajectory.as_ref().map(|t| t.describe()),
+            }
+        })
+        .filter(|s| s.from < s.to)
+        .collect()
+}
+
+/// The segments as the plan a link carried before plans were the planner's (still written
+/// for takes without a plan).
 pub fn plan_json(segments: &[Segment]) -> String {
     let list: Vec<_> = segments
         .iter()
@@ -49,9 +149,29 @@ pub fn plan_json(segments: &[Segment]) -> String {
     serde_json::json!({ "segments": list }).to_string()
 }
 
-/// Segments back from a link's plan; a plan that does not read gives one segment over the
-/// whole motion with the prompt as its text.
+/// A link's plan: the planner's plan when it reads as one, else the older segments-only
+/// form, else one segment over the whole motion with the prompt as its text.
+pub fn plan_from_link(plan: &str, prompt: &str, frames: usize) -> (Option<Plan>, Vec<Segment>) {
+    if let Ok(plan) = crate::planning::parse_plan(plan) {
+        let segments = plan_segments(&plan, frames);
+        if !segments.is_empty() {
+            return (Some(plan), segments);
+        }
+    }
+    (None, segments_from_plan(plan, prompt, frames))
+}
+
+/// Segments back from an older link's plan; a plan that does not read gives one segment
+/// over the whole motion with the prompt as its text.
 pub fn segments_from_plan(plan: &str, prompt: &str, frames: usize) -> Vec<Segment> {
+    let whole = |text: String, from, to| Segment {
+        text,
+        from,
+        to,
+        base: String::new(),
+        parts: Vec::new(),
+        path: None,
+    };
     let parsed: Option<Vec<Segment>> = serde_json::from_str::<serde_json::Value>(plan)
         .ok()
         .and_then(|v| {
@@ -62,17 +182,37 @@ pub fn segments_from_plan(plan: &str, prompt: &str, frames: usize) -> Vec<Segmen
                     let from = s.get("from")?.as_u64()? as usize;
                     let to = s.get("to")?.as_u64()? as usize;
                     let text: String = s.get("text")?.as_str()?.chars().take(500).collect();
-                    (from < to && to <= frames).then_some(Segment { text, from, to })
+                    (from < to && to <= frames).then(|| whole(text, from, to))
                 })
                 .collect()
         });
     match parsed {
         Some(s) if !s.is_empty() => s,
-        _ => vec![Segment {
-            text: prompt.to_string(),
-            from: 0,
-            to: frames,
-        }],
+        _ => vec![whole(prompt.to_string(), 0, frames)],
+    }
+}
+
+/// One line for an edit of the history, as the Steps panel lists it.
+pub fn edit_line(edit: &Edit) -> String {
+    let span = format!(
+        "{:.1}–{:.1} s",
+        edit.from_frame as f64 / 20.0,
+        edit.to_frame as f64 / 20.0
+    );
+    let parts: Vec<&str> = coma::skeleton::BodyPart::ALL
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| edit.parts & (1 << i) != 0)
+        .map(|(_, p)| p.name())
+        .collect();
+    let text: String = edit.text.chars().take(200).collect();
+    match edit.kind {
+        EditKind::Generate => format!("generate \"{text}\" ({span})"),
+        EditKind::BodyParts => format!("{} ← \"{text}\" ({span})", parts.join(", ")),
+        EditKind::InBetween => format!("regenerate {span} from \"{text}\""),
+        EditKind::Regenerate => format!("regenerate the segment {span} from \"{text}\""),
+        EditKind::Blend => format!("blend the join {span}"),
+        EditKind::Trajectory => format!("path \"{text}\" ({span})"),
     }
 }
 
@@ -93,37 +233,78 @@ pub fn joints_hash(joints: &[[[f32; 3]; 22]]) -> String {
 mod tests {
     use super::*;
 
+    fn legacy(text: &str, from: usize, to: usize) -> Segment {
+        Segment {
+            text: text.into(),
+            from,
+            to,
+            base: String::new(),
+            parts: Vec::new(),
+            path: None,
+        }
+    }
+
     #[test]
-    fn plans_round_trip_and_bad_plans_fall_back_to_one_segment() {
-        let segments = vec![
-            Segment {
-                text: "walk forward".into(),
-                from: 0,
-                to: 80,
-            },
-            Segment {
-                text: "bow".into(),
-                from: 80,
-                to: 120,
-            },
-        ];
+    fn older_plans_round_trip_and_bad_plans_fall_back_to_one_segment() {
+        let segments = vec![legacy("walk forward", 0, 80), legacy("bow", 80, 120)];
         let plan = plan_json(&segments);
         assert_eq!(segments_from_plan(&plan, "p", 120), segments);
+        assert_eq!(plan_from_link(&plan, "p", 120), (None, segments.clone()));
         for bad in [
             "",
             "{",
             r#"{"segments":[{"text":"x","from":5,"to":2}]}"#,
             r#"{"segments":[]}"#,
         ] {
-            let s = segments_from_plan(bad, "the prompt", 60);
-            assert_eq!(s.len(), 1);
-            assert_eq!(
-                (s[0].text.as_str(), s[0].from, s[0].to),
-                ("the prompt", 0, 60)
-            );
+            let (none, s) = plan_from_link(bad, "the prompt", 60);
+            assert_eq!(none, None);
+            assert_eq!(s, vec![legacy("the prompt", 0, 60)]);
         }
         // A segment beyond the motion is not believed either.
         assert_eq!(segments_from_plan(&plan, "p", 100).len(), 1);
+    }
+
+    #[test]
+    fn planned_segments_lie_where_the_pipeline_puts_them() {
+        let plan = coma::agents::planner::offline::plan(
+            "A person walks forward waving the left hand, then turns right and bows",
+            None,
+        );
+        // 4 + 5 + 3 s of token steps, as blended.
+        let tokens: coma::model::generate::MotionTokens = vec![vec![vec![0; 60]; 1]; 4];
+        let ranges = coma::agents::pipeline::segment_ranges(&plan, &tokens);
+        let segments = plan_segments(&plan, 240);
+        let ours: Vec<_> = segments.iter().map(|s| s.from..s.to).collect();
+        assert_eq!(ours, ranges);
+        assert_eq!(segments[0].parts[0].0, "left arm");
+        assert_eq!(segments[1].seconds(), 5.0);
+        // While the motion is being made, the plan alone places them.
+        assert_eq!(plan_segments(&plan, 0), segments);
+        // A shorter motion (a link's) cuts the segments that do not fit.
+        assert_eq!(plan_segments(&plan, 100).len(), 2);
+        let json = serde_json::to_string(&plan).unwrap();
+        let (read, again) = plan_from_link(&json, "p", 240);
+        assert_eq!((read.as_ref(), again), (Some(&plan), segments));
+    }
+
+    #[test]
+    fn every_edit_has_a_line() {
+        let edit = |kind, parts| Edit {
+            kind,
+            text: "a person waves the left hand".into(),
+            from_frame: 80,
+            to_frame: 180,
+            parts,
+            seed: 1,
+        };
+        assert_eq!(
+            edit_line(&edit(EditKind::BodyParts, 0b0101)),
+            "left arm, left leg ← \"a person waves the left hand\" (4.0–9.0 s)"
+        );
+        assert_eq!(
+            edit_line(&edit(EditKind::Blend, 0b1111)),
+            "blend the join 4.0–9.0 s"
+        );
     }
 
     #[test]

@@ -2,12 +2,24 @@
 //! models and answers [`Request`]s, so generating never freezes the page. Replies go back as
 //! [`Reply`] JSON; a failed request answers with an error and leaves the models as they were.
 
-use crate::messages::{from_json, to_json, Backend, Motion, Reply, Request};
+use crate::llm_fetch::FetchTransport;
+use crate::messages::{
+    from_json, to_json, Backend, LlmSettings, Motion, Reply, Request, SegmentScores,
+};
+use crate::planning;
+use coma::agents::llm::{LlmClient, LlmConfig};
+use coma::agents::pipeline::{self, RunOptions};
+use coma::agents::plan::Plan;
+use coma::agents::planner::{self, offline::Embedder};
+use coma::agents::reviewer::Scorer;
+use coma::dataset::Vocabulary;
+use coma::eval::evaluator::{Evaluator, EvaluatorConfig};
 use coma::model::generate::MotionTokens;
 use coma::model::motion_model::{frames_for_seconds, TextFiles};
 use coma::model::{MotionModel, SpamFiles};
 use coma::skeleton::BodyPart;
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
+use std::rc::Rc;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{DedicatedWorkerGlobalScope, MessageEvent};
@@ -21,8 +33,21 @@ fn model_files() -> Vec<&'static str> {
     files
 }
 
+/// The agents' files, fetched after the model: the page works without them, with less.
+const EVALUATOR_FILES: [&str; 2] = ["evaluator.json", "evaluator.bpk"];
+const VOCABULARY_FILE: &str = "vocabulary.json";
+
+/// Everything loaded: the motion model, and what the reviewer and the LLM planner need
+/// where it loaded.
+struct Models {
+    model: MotionModel,
+    evaluator: Option<(Evaluator, EvaluatorConfig)>,
+    vocabulary: Option<Vocabulary>,
+}
+
 thread_local! {
-    static MODEL: RefCell<Option<MotionModel>> = const { RefCell::new(None) };
+    // Shared out as an Rc so a request can hold the models across the awaits of an LLM call.
+    static MODELS: RefCell<Option<Rc<Models>>> = const { RefCell::new(None) };
 }
 
 fn scope() -> DedicatedWorkerGlobalScope {
@@ -79,15 +104,23 @@ async fn load(base: &str) -> Result<Reply, String> {
     let started = now();
     let base = base.trim_end_matches('/');
     let names = model_files();
-    let mut files = Vec::with_capacity(names.len());
+    let total = (names.len() + EVALUATOR_FILES.len() + 1) as u64;
+    let mut done = 0u64;
     let mut bytes = 0u64;
-    for (i, name) in names.iter().enumerate() {
+    let mut download = async |name: &str| {
         post(&Reply::Progress {
             stage: format!("downloading the model: {name}"),
-            done: i as u64,
-            total: names.len() as u64,
+            done,
+            total,
         });
-        let data = fetch(&format!("{base}/{name}")).await.map_err(|e| {
+        done += 1;
+        let data = fetch(&format!("{base}/{name}")).await?;
+        bytes += data.len() as u64;
+        Ok::<_, String>(data)
+    };
+    let mut files = Vec::with_capacity(names.len());
+    for (i, name) in names.iter().copied().enumerate() {
+        let data = download(name).await.map_err(|e| {
             if i == 0 {
                 format!(
                     "The motion model is not on this server ({e}). Its default weights are still \
@@ -97,13 +130,18 @@ async fn load(base: &str) -> Result<Reply, String> {
                 e
             }
         })?;
-        bytes += data.len() as u64;
         files.push(data);
     }
+    // Optional: a failure here costs the review or the LLM planner, not the page.
+    let evaluator_files = [
+        download(EVALUATOR_FILES[0]).await,
+        download(EVALUATOR_FILES[1]).await,
+    ];
+    let vocabulary_file = download(VOCABULARY_FILE).await;
     post(&Reply::Progress {
         stage: "preparing the model".into(),
-        done: names.len() as u64,
-        total: names.len() as u64,
+        done: total,
+        total,
     });
     let text = |i: usize| {
         std::str::from_utf8(&files[i]).map_err(|_| format!("{} is not UTF-8 text", names[i]))
@@ -128,14 +166,50 @@ async fn load(base: &str) -> Result<Reply, String> {
         &device,
     )
     .map_err(|e| format!("the model does not load: {e}"))?;
+    let mut missing = Vec::new();
+    let evaluator = match evaluator_files {
+        [Ok(config), Ok(weights)] => std::str::from_utf8(&config)
+            .map_err(|_| "evaluator.json is not UTF-8 text".to_string())
+            .and_then(|config| {
+                Evaluator::from_bytes(config, &weights, &device).map_err(|e| e.to_string())
+            }),
+        [config, weights] => Err(config.err().or(weights.err()).unwrap_or_default()),
+    };
+    let evaluator = match evaluator {
+        Ok(evaluator) => Some(evaluator),
+        Err(e) => {
+            missing.push(format!("the evaluator ({e}): motions are not reviewed"));
+            None
+        }
+    };
+    let vocabulary = vocabulary_file.and_then(|data| {
+        serde_json::from_slice::<Vocabulary>(&data)
+            .map_err(|e| format!("{VOCABULARY_FILE} does not read: {e}"))
+    });
+    let vocabulary = match vocabulary {
+        Ok(vocabulary) => Some(vocabulary),
+        Err(e) => {
+            missing.push(format!(
+                "the model's vocabulary ({e}): the built-in planner plans even with an LLM set"
+            ));
+            None
+        }
+    };
     let model_id = model.id.clone();
-    MODEL.with(|m| *m.borrow_mut() = Some(model));
+    MODELS.with(|m| {
+        *m.borrow_mut() = Some(Rc::new(Models {
+            model,
+            evaluator,
+            vocabulary,
+        }))
+    });
     Ok(Reply::Loaded {
         model_id,
         backend: Backend::Cpu,
         note: Some("the model runs on the CPU backend in this version".into()),
         bytes,
         millis: now() - started,
+        missing,
     })
 }
 
@@ -173,87 +247,233 @@ fn check_tokens(model: &MotionModel, tokens: &MotionTokens) -> Result<(), String
     }
 }
 
-fn motion(model: &MotionModel, tokens: MotionTokens) -> Motion {
-    let features = model.features(&tokens);
+/// The motion of `tokens`, with the paths of `plan` (JSON) laid on its root where it reads
+/// as a plan; the notes say which paths could not be laid.
+fn motion(model: &MotionModel, tokens: MotionTokens, plan: Option<&str>) -> (Motion, Vec<String>) {
+    let plan = plan.and_then(|p| planning::parse_plan(p).ok());
+    let (features, notes) = match &plan {
+        Some(plan) => pipeline::motion_features(model, plan, &tokens),
+        None => (model.features(&tokens), Vec::new()),
+    };
     let joints = coma::features::features_to_joints(&features)
         .iter()
         .map(|p| p.map(|j| j.map(|v| v as f32)))
         .collect();
-    Motion {
+    let motion = Motion {
         tokens,
         joints,
         features: features.iter().map(|f| f.to_vec()).collect(),
-    }
+    };
+    (motion, notes)
+}
+
+fn models() -> Result<Rc<Models>, String> {
+    MODELS
+        .with(|m| m.borrow().clone())
+        .ok_or("the model is not loaded yet".to_string())
 }
 
 async fn answer(request: Request) -> Result<Reply, String> {
-    if let Request::Load { base } = &request {
-        return load(base).await;
+    match request {
+        Request::Load { base } => load(&base).await,
+        Request::Run {
+            prompt,
+            seed,
+            rounds,
+            seconds,
+            llm,
+            plan,
+        } => {
+            let models = models()?;
+            run(&models, &prompt, seed, rounds, seconds, llm, plan).await
+        }
+        other => {
+            let models = models()?;
+            edit(&models.model, other)
+        }
     }
+}
+
+/// The LLM client for `settings`, or why there is none.
+fn llm_client(settings: LlmSettings) -> Result<LlmClient<FetchTransport>, String> {
+    let mut config =
+        LlmConfig::new(settings.base_url, settings.model).with_api_key(settings.api_key);
+    config.vision_model = (!settings.vision_model.is_empty()).then_some(settings.vision_model);
+    LlmClient::new(config, FetchTransport).map_err(|e| e.to_string())
+}
+
+/// A Run: plan (or take the given plan), then the whole loop, posting every step.
+async fn run(
+    models: &Models,
+    prompt: &str,
+    seed: u64,
+    rounds: usize,
+    seconds: Option<f64>,
+    llm: Option<LlmSettings>,
+    given: Option<String>,
+) -> Result<Reply, String> {
     let started = now();
-    MODEL.with(|m| {
-        let guard = m.borrow();
-        let model = guard
-            .as_ref()
-            .ok_or("the model is not loaded yet".to_string())?;
-        let tokens = match request {
-            Request::Load { .. } => unreachable!("answered above"),
-            Request::Generate {
-                prompt,
-                seconds,
-                seed,
-                parts,
-            } => {
-                let parts = parts
-                    .iter()
-                    .map(|(name, text)| {
-                        Ok((parse_parts(std::slice::from_ref(name))?[0], text.clone()))
-                    })
-                    .collect::<Result<Vec<_>, String>>()?;
-                if prompt.trim().is_empty() {
-                    return Err("type what the person should do first".into());
-                }
-                model.generate(&prompt, &parts, frames_for_seconds(seconds), seed)
+    if prompt.trim().is_empty() && given.is_none() {
+        return Err("type what the person should do first".into());
+    }
+    let model = &models.model;
+    // Steps so far; a Cell, since the planner's and the pipeline's callbacks both count.
+    let done = Cell::new(0u64);
+    let step = |line: String, total: u64| {
+        done.set(done.get() + 1);
+        post(&Reply::Step {
+            line,
+            done: done.get(),
+            total: total.max(done.get()),
+        });
+    };
+    let mut notes = Vec::new();
+    let client = match llm.map(llm_client) {
+        Some(Ok(client)) => Some(client),
+        Some(Err(e)) => {
+            notes.push(format!(
+                "the LLM is not used ({e}); the built-in planner planned"
+            ));
+            None
+        }
+        None => None,
+    };
+    let embed_fn = |s: &str| model.text.encode(&[s])[0].to_vec();
+    let embed: Embedder = &embed_fn;
+    let mut plan: Plan = match (given, &client, &models.vocabulary) {
+        (Some(json), _, _) => planning::parse_plan(&json)?,
+        (None, Some(client), Some(vocabulary)) => {
+            step(format!("planning with {}…", client.config().model), 1);
+            planner::llm::plan(client, prompt, vocabulary, Some(embed), &mut |event| {
+                step(planning::plan_event_line(event), 0)
+            })
+            .await
+        }
+        (None, client, _) => {
+            if client.is_some() {
+                notes.push(
+                    "the model's vocabulary did not load, so the built-in planner planned".into(),
+                );
             }
-            Request::InBetween {
-                tokens,
-                text,
-                from,
-                to,
-                seed,
-            } => {
-                check_tokens(model, &tokens)?;
-                let frames = tokens[0][0].len() * 4;
-                if from >= to || from >= frames {
-                    return Err(format!(
-                        "choose a time range inside the motion (0 to {:.1} s)",
-                        frames as f64 / 20.0
-                    ));
-                }
-                model.inbetween(&tokens, &text, from, to.min(frames), seed)
+            planner::offline::plan(prompt, Some(embed))
+        }
+    };
+    if let Some(seconds) = seconds {
+        planning::fit_seconds(&mut plan, seconds);
+    }
+    if done.get() == 0 {
+        // Planned in one go (the built-in planner, or a given plan): its steps, as fitted.
+        for event in planning::plan_events(&plan) {
+            step(planning::plan_event_line(&event), 0);
+        }
+    }
+    post(&Reply::Plan {
+        plan: serde_json::to_string(&plan).map_err(|e| e.to_string())?,
+    });
+    let total = done.get() + planning::run_steps(&plan, rounds);
+    let scorer = models.evaluator.as_ref().map(|(evaluator, config)| Scorer {
+        evaluator,
+        config,
+        model,
+    });
+    let run = pipeline::run(
+        model,
+        scorer.as_ref(),
+        client.as_ref(),
+        plan,
+        RunOptions { rounds, seed },
+        &mut |event| step(pipeline::describe_event(&event), total),
+    )
+    .await;
+    let (motion, path_notes) = motion(
+        model,
+        run.tokens.clone(),
+        serde_json::to_string(&run.plan).ok().as_deref(),
+    );
+    let scores: Vec<SegmentScores> = planning::scores(&run);
+    notes.extend(run.plan.notes.iter().cloned());
+    notes.extend(run.notes.iter().cloned());
+    notes.extend(path_notes);
+    Ok(Reply::Run {
+        motion,
+        plan: serde_json::to_string(&run.plan).map_err(|e| e.to_string())?,
+        history: run.history,
+        notes,
+        scores,
+        millis: now() - started,
+    })
+}
+
+/// The requests that make or change tokens without the agents.
+fn edit(model: &MotionModel, request: Request) -> Result<Reply, String> {
+    let started = now();
+    let (tokens, plan) = match request {
+        Request::Load { .. } | Request::Run { .. } => {
+            return Err("this request is not an edit".into())
+        }
+        Request::Generate {
+            prompt,
+            seconds,
+            seed,
+            parts,
+        } => {
+            let parts = parts
+                .iter()
+                .map(|(name, text)| Ok((parse_parts(std::slice::from_ref(name))?[0], text.clone())))
+                .collect::<Result<Vec<_>, String>>()?;
+            if prompt.trim().is_empty() {
+                return Err("type what the person should do first".into());
             }
-            Request::EditParts {
-                tokens,
-                text,
-                parts,
-                seed,
-            } => {
-                check_tokens(model, &tokens)?;
-                let parts = parse_parts(&parts)?;
-                if parts.is_empty() {
-                    return Err("choose at least one body part to edit".into());
-                }
-                let rest = coma::posecodes::describe_motion(&model.joints(&tokens));
-                model.edit_parts(&tokens, &text, &parts, &rest, seed)
+            (
+                model.generate(&prompt, &parts, frames_for_seconds(seconds), seed),
+                None,
+            )
+        }
+        Request::InBetween {
+            tokens,
+            text,
+            from,
+            to,
+            seed,
+            plan,
+        } => {
+            check_tokens(model, &tokens)?;
+            let frames = tokens[0][0].len() * 4;
+            if from >= to || from >= frames {
+                return Err(format!(
+                    "choose a time range inside the motion (0 to {:.1} s)",
+                    frames as f64 / 20.0
+                ));
             }
-            Request::Decode { tokens } => {
-                check_tokens(model, &tokens)?;
-                tokens
+            (
+                model.inbetween(&tokens, &text, from, to.min(frames), seed),
+                plan,
+            )
+        }
+        Request::EditParts {
+            tokens,
+            text,
+            parts,
+            seed,
+            plan,
+        } => {
+            check_tokens(model, &tokens)?;
+            let parts = parse_parts(&parts)?;
+            if parts.is_empty() {
+                return Err("choose at least one body part to edit".into());
             }
-        };
-        Ok(Reply::Motion {
-            motion: motion(model, tokens),
-            millis: now() - started,
-        })
+            let rest = coma::posecodes::describe_motion(&model.joints(&tokens));
+            (model.edit_parts(&tokens, &text, &parts, &rest, seed), plan)
+        }
+        Request::Decode { tokens, plan } => {
+            check_tokens(model, &tokens)?;
+            (tokens, plan)
+        }
+    };
+    let (motion, notes) = motion(model, tokens, plan.as_deref());
+    Ok(Reply::Motion {
+        motion,
+        millis: now() - started,
+        notes,
     })
 }

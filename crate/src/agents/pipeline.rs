@@ -470,7 +470,7 @@ pub fn describe_event(event: &RunEvent) -> String {
                 let fixes: Vec<String> = review
                     .corrections
                     .iter()
-                    .map(|c| format!("{:?} ← \"{}\"", c.region, c.instruction))
+                    .map(|c| format!("{} ← \"{}\"", c.region.name(), c.instruction))
                     .collect();
                 format!(
                     "{} ({})",

@@ -33,6 +33,15 @@ impl Region {
     /// All regions, in the order they are reviewed.
     pub const ALL: [Region; 3] = [Region::LeftArm, Region::RightArm, Region::LowerBody];
 
+    /// The region in the user's words ("left arm", "lower body").
+    pub fn name(self) -> &'static str {
+        match self {
+            Region::LeftArm => "left arm",
+            Region::RightArm => "right arm",
+            Region::LowerBody => "lower body",
+        }
+    }
+
     /// The model's body parts of the region.
     pub fn parts(self) -> &'static [BodyPart] {
         match self {
@@ -180,7 +189,7 @@ fn judge_schema() -> serde_json::Value {
 fn judge_messages(segment: &Segment, description: &str) -> Vec<Message> {
     let asked: Vec<String> = Region::ALL
         .iter()
-        .map(|r| format!("{:?}: {}", r, r.asked(segment)))
+        .map(|r| format!("{}: {}", r.name(), r.asked(segment)))
         .collect();
     vec![
         Message::system(

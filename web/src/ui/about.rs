@@ -11,16 +11,22 @@ pub fn About() -> impl IntoView {
     let model_line = move || {
         state.model.with(|m| match m {
             None => "The model is loading.".to_string(),
-            Some(m) => format!(
-                "Model {} ({:.1} MB), running on {}{}.",
-                m.id,
-                m.bytes as f64 / 1e6,
-                match m.backend {
-                    Backend::WebGpu => "WebGPU",
-                    Backend::Cpu => "the CPU",
-                },
-                m.note.as_ref().map_or(String::new(), |n| format!(": {n}"))
-            ),
+            Some(m) => {
+                format!(
+                    "Model {} ({:.1} MB), running on {}{}.",
+                    m.id,
+                    m.bytes as f64 / 1e6,
+                    match m.backend {
+                        Backend::WebGpu => "WebGPU",
+                        Backend::Cpu => "the CPU",
+                    },
+                    m.note.as_ref().map_or(String::new(), |n| format!(": {n}"))
+                ) + &m
+                    .missing
+                    .iter()
+                    .map(|n| format!(" Not loaded: {n}."))
+                    .collect::<String>()
+            }
         })
     };
     view! {
@@ -29,7 +35,9 @@ pub fn About() -> impl IntoView {
             <div class="about-body">
                 <p>
                     "Type a motion prompt; the page generates a 3D human motion with SPAM, a body-part-aware "
-                    "residual VQ-VAE and masked transformers, entirely in this browser: nothing is sent anywhere."
+                    "residual VQ-VAE and masked transformers, entirely in this browser. A built-in planner cuts the "
+                    "prompt into segments and body-part edits and an evaluator reviews the result, so nothing is sent "
+                    "anywhere unless you set an LLM endpoint under Settings."
                 </p>
                 <p id="model-line">{model_line}</p>
                 <h3>"Licences"</h3>

@@ -2,7 +2,10 @@
 
 pub mod about;
 pub mod prompt;
+pub mod segments;
+pub mod settings;
 pub mod status;
+pub mod steps;
 pub mod timeline;
 pub mod toolbar;
 pub mod viewer;

@@ -1,9 +1,14 @@
-//! The prompt box: what the person should do, how long, which seed, and Generate
-//! (also Ctrl+Enter).
+//! The prompt box: what the person should do, how long, which seed, how many review rounds,
+//! and Generate (also Ctrl+Enter), which runs the whole pipeline: plan, generate, edit,
+//! review, blend.
 
 use crate::app::{AppState, Pending};
 use crate::messages::Request;
+use coma::agents::pipeline::DEFAULT_ROUNDS;
 use leptos::prelude::*;
+
+/// Most review rounds offered: each round may regenerate every body part of every segment.
+const MAX_ROUNDS: usize = 4;
 
 /// Prompts the default model knows (its training vocabulary, see MODEL_CARD.md).
 pub const EXAMPLES: [&str; 8] = [
@@ -21,8 +26,10 @@ pub const EXAMPLES: [&str; 8] = [
 pub fn PromptBox() -> impl IntoView {
     let state = expect_context::<AppState>();
     let prompt = RwSignal::new(EXAMPLES[0].to_string());
-    let seconds = RwSignal::new(4.0f64);
+    // None: the planner estimates each segment's length.
+    let seconds = RwSignal::new(None::<f64>);
     let seed = RwSignal::new(0u64);
+    let rounds = RwSignal::new(DEFAULT_ROUNDS);
     let generate = move || {
         let text = prompt.get_untracked().trim().to_string();
         if text.is_empty() {
@@ -30,15 +37,21 @@ pub fn PromptBox() -> impl IntoView {
             return;
         }
         let s = seed.get_untracked();
-        state.say("generating…");
+        let llm = state.settings.get_untracked().active();
+        state.say(match &llm {
+            Some(l) => format!("planning with {}…", l.model),
+            None => "planning…".to_string(),
+        });
         state.request(
-            Request::Generate {
+            Request::Run {
                 prompt: text.clone(),
-                seconds: seconds.get_untracked(),
                 seed: s,
-                parts: vec![],
+                rounds: rounds.get_untracked(),
+                seconds: seconds.get_untracked(),
+                llm,
+                plan: None,
             },
-            Pending::Generate {
+            Pending::Run {
                 prompt: text,
                 seed: s,
             },
@@ -72,19 +85,24 @@ pub fn PromptBox() -> impl IntoView {
                     <option value="">"Examples…"</option>
                     {EXAMPLES.iter().map(|e| view! { <option value=*e>{*e}</option> }).collect_view()}
                 </select>
-                <label>
+                <label title="The whole motion's length; empty lets the planner choose">
                     "Seconds "
                     <input
                         id="seconds"
                         type="number"
-                        min="1"
-                        max="9.8"
+                        min="2"
+                        max="39.2"
                         step="0.2"
-                        prop:value=move || seconds.get().to_string()
+                        placeholder="auto"
+                        prop:value=move || seconds.get().map_or(String::new(), |s| s.to_string())
                         on:change=move |ev| {
-                            match event_target_value(&ev).parse::<f64>() {
-                                Ok(v) if v.is_finite() => seconds.set(v.clamp(1.0, 9.8)),
-                                _ => state.fail("Seconds must be a number from 1 to 9.8."),
+                            let text = event_target_value(&ev);
+                            match text.trim() {
+                                "" => seconds.set(None),
+                                t => match t.parse::<f64>() {
+                                    Ok(v) if v.is_finite() && v > 0.0 => seconds.set(Some(v)),
+                                    _ => state.fail("Seconds is a number, or empty to let the planner choose."),
+                                },
                             }
                         }
                     />
@@ -104,6 +122,27 @@ pub fn PromptBox() -> impl IntoView {
                             }
                         }
                     />
+                </label>
+                <label title="Review rounds per segment (0: no review)">
+                    "Review "
+                    <select
+                        id="rounds"
+                        on:change=move |ev| {
+                            if let Ok(r) = event_target_value(&ev).parse::<usize>() {
+                                rounds.set(r.min(MAX_ROUNDS));
+                            }
+                        }
+                    >
+                        {(0..=MAX_ROUNDS)
+                            .map(|r| {
+                                view! {
+                                    <option value=r.to_string() selected=r == DEFAULT_ROUNDS>
+                                        {r.to_string()}
+                                    </option>
+                                }
+                            })
+                            .collect_view()}
+                    </select>
                 </label>
                 <button
                     id="generate"

@@ -3,28 +3,30 @@
 
 use crate::app::{AppState, Pending};
 use crate::messages::Request;
-use coma::model::motion_model::frames_for_seconds;
+use coma::agents::pipeline::DEFAULT_ROUNDS;
 use leptos::prelude::*;
 
 #[component]
 pub fn StatusBar() -> impl IntoView {
     let state = expect_context::<AppState>();
+    // Runs the link's own plan with its seed on this page's model: the same steps, though
+    // not the same motion.
     let regenerate = move |_| {
         if let Some(link) = state.foreign_link.get_untracked() {
             state.foreign_link.set(None);
-            let frames = link
-                .tokens
-                .first()
-                .and_then(|p| p.first())
-                .map_or(80, |l| l.len() * 4);
+            let plan = crate::planning::parse_plan(&link.plan)
+                .ok()
+                .map(|_| link.plan.clone());
             state.request(
-                Request::Generate {
+                Request::Run {
                     prompt: link.prompt.clone(),
-                    seconds: frames_for_seconds(frames as f64 / 20.0) as f64 / 20.0,
                     seed: link.seed,
-                    parts: vec![],
+                    rounds: DEFAULT_ROUNDS,
+                    seconds: None,
+                    llm: None,
+                    plan,
                 },
-                Pending::Generate {
+                Pending::Run {
                     prompt: link.prompt,
                     seed: link.seed,
                 },

@@ -1,7 +1,8 @@
-//! The timeline: the motion's segments with their texts and the playhead; a time range and
-//! body parts to edit with an instruction (in-between or body-part edit); regenerating one
-//! segment; undo and redo.
+//! The timeline: the plan's segments (see [`super::segments`]) with the playhead; a time
+//! range and body parts to edit with an instruction (in-between or body-part edit); undo and
+//! redo.
 
+use super::segments::{next_seed, shown_segments, PlanList, SegmentBar};
 use crate::app::{AppState, Pending};
 use crate::messages::Request;
 use coma::share::{Edit, EditKind};
@@ -9,13 +10,6 @@ use coma::skeleton::BodyPart;
 use leptos::prelude::*;
 
 const FPS: f64 = 20.0;
-
-/// A fresh seed for an edit: different from the take's, reproducible from it.
-fn next_seed(state: &AppState) -> u64 {
-    state
-        .take()
-        .map_or(1, |t| t.seed.wrapping_add(1 + t.edits.len() as u64))
-}
 
 #[component]
 pub fn Timeline() -> impl IntoView {
@@ -52,6 +46,7 @@ pub fn Timeline() -> impl IntoView {
                 from: a,
                 to: b,
                 seed,
+                plan: Some(take.plan_json()),
             },
             Pending::Edit(Edit {
                 kind: EditKind::InBetween,
@@ -91,6 +86,7 @@ pub fn Timeline() -> impl IntoView {
                 text: text.clone(),
                 parts: names,
                 seed,
+                plan: Some(take.plan_json()),
             },
             Pending::Edit(Edit {
                 kind: EditKind::BodyParts,
@@ -98,31 +94,6 @@ pub fn Timeline() -> impl IntoView {
                 from_frame: 0,
                 to_frame: take.frames() as u32,
                 parts: mask,
-                seed,
-            }),
-        );
-    };
-    let regenerate = move |index: usize| {
-        let Some(take) = state.take() else { return };
-        let Some(segment) = take.segments.get(index).cloned() else {
-            return;
-        };
-        let seed = next_seed(&state);
-        state.say("regenerating the segment…");
-        state.request(
-            Request::InBetween {
-                tokens: take.motion.tokens.clone(),
-                text: segment.text.clone(),
-                from: segment.from,
-                to: segment.to,
-                seed,
-            },
-            Pending::Edit(Edit {
-                kind: EditKind::Regenerate,
-                text: segment.text,
-                from_frame: segment.from as u32,
-                to_frame: segment.to as u32,
-                parts: 0,
                 seed,
             }),
         );
@@ -136,57 +107,13 @@ pub fn Timeline() -> impl IntoView {
             }
         });
         state.frame.set(0.0);
-        if let (Some(take), Some(model)) = (state.take(), state.model.get_untracked()) {
-            if let Some(id) = coma::share::model_id_bytes(&model.id) {
-                crate::browser::set_fragment(&coma::share::encode(&take.shared(id)));
-            }
-        }
+        state.publish();
     };
-    let segments = move || {
-        state.history.with(|h| {
-            h.current().as_ref().map_or_else(Vec::new, |t| {
-                let total = t.frames().max(1) as f64;
-                t.segments
-                    .iter()
-                    .enumerate()
-                    .map(|(i, s)| (i, s.text.clone(), (s.to - s.from) as f64 / total * 100.0))
-                    .collect()
-            })
-        })
-    };
+    let shown = shown_segments(state);
     view! {
         <div class="panel timeline">
-            <div class="segments" aria-label="Segments">
-                {move || {
-                    segments()
-                        .into_iter()
-                        .map(|(i, text, width)| {
-                            let title = text.clone();
-                            view! {
-                                <div class="segment" style=format!("width: {width:.2}%") title=title>
-                                    <span>{text}</span>
-                                    <button
-                                        class="small"
-                                        on:click=move |_| regenerate(i)
-                                        disabled=move || state.busy()
-                                    >
-                                        "Regenerate"
-                                    </button>
-                                </div>
-                            }
-                        })
-                        .collect_view()
-                }}
-                <div
-                    class="playhead"
-                    style=move || {
-                        format!(
-                            "left: {:.2}%",
-                            state.frame.get() / frames().max(1) as f64 * 100.0,
-                        )
-                    }
-                ></div>
-            </div>
+            <SegmentBar shown/>
+            <PlanList shown/>
             <div class="row">
                 <label>
                     "From "

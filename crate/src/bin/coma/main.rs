@@ -718,8 +718,7 @@ fn evaluate(
     spam_dir: Option<&std::path::Path>,
     options: &coma::eval::protocol::ProtocolOptions,
     probe_seeds: u64,
-    markdown: &std::path::Path,
-    json: &std::path::Path,
+    (markdown, json): (&std::path::Path, &std::path::Path),
     agent_options: &AgentEvalOptions,
 ) -> Result<()> {
     use coma::eval::protocol::{Protocol, Source};
@@ -1113,8 +1112,7 @@ fn run(cli: Cli) -> Result<()> {
                 spam,
                 &options,
                 probe_seeds,
-                &markdown,
-                &json,
+                (&markdown, &json),
                 &AgentEvalOptions {
                     prompts,
                     review_rounds,
