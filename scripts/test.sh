@@ -26,8 +26,13 @@ scripts/llm_server.sh stop
 echo "== the page builds"
 build_page
 
-echo "== the page in headless Chromium"
 ensure_browser_tools
+echo "== wasm tests in headless Chromium (the link decoder against a corpus of broken links)"
+CHROMEDRIVER=/usr/bin/chromedriver \
+  CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner \
+  cargo test --release -p coma-web --target wasm32-unknown-unknown --test links
+
+echo "== the page in headless Chromium"
 target_dir="${CARGO_TARGET_DIR:-target}"
 if [ ! -f dist/static/models/spam.json ]; then
   # No trained SPAM is committed yet: the suite checks the page's plumbing with random
