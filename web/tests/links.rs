@@ -23,7 +23,11 @@ fn sample() -> SharedMotion {
             seed: 42,
         }],
         tokens: (0..4)
-            .map(|p| (0..4).map(|l| (0..20).map(|s| (p * 97 + l * 13 + s) % 512).collect()).collect())
+            .map(|p| {
+                (0..4)
+                    .map(|l| (0..20).map(|s| (p * 97 + l * 13 + s) % 512).collect())
+                    .collect()
+            })
             .collect(),
     }
 }
@@ -33,7 +37,10 @@ fn a_link_survives_the_round_trip_in_the_browser() {
     let motion = sample();
     let link = encode(&motion);
     assert_eq!(decode(&link).unwrap(), motion);
-    assert_eq!(decode(&format!("https://example.com/#{link}")).unwrap(), motion);
+    assert_eq!(
+        decode(&format!("https://example.com/#{link}")).unwrap(),
+        motion
+    );
 }
 
 #[wasm_bindgen_test]
@@ -60,7 +67,10 @@ fn every_broken_link_of_the_corpus_gives_a_message() {
         match decode(link) {
             Err(e) => {
                 let message = e.to_string();
-                assert!(!message.is_empty() && message.len() < 300, "{link:?}: {message}");
+                assert!(
+                    !message.is_empty() && message.len() < 300,
+                    "{link:?}: {message}"
+                );
                 refused += 1;
             }
             // A substitution can land in a spot that still decodes (a token value, a letter of
@@ -68,5 +78,9 @@ fn every_broken_link_of_the_corpus_gives_a_message() {
             Ok(m) => assert!(m.tokens.len() <= 8 && m.prompt.len() <= 4096, "{link:?}"),
         }
     }
-    assert!(links.len() > 100 && refused > links.len() / 2, "{refused} of {}", links.len());
+    assert!(
+        links.len() > 100 && refused > links.len() / 2,
+        "{refused} of {}",
+        links.len()
+    );
 }
