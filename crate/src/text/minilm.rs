@@ -196,16 +196,7 @@ impl MiniLm {
     /// Whether the parameter `name` of this module is stored as int8: the Linear weights of
     /// the encoder layers (every `.weight` under `layers.`; the LayerNorms' are `gamma`).
     fn stored_as_int8(name: &str) -> bool {
-        let linear = name.starts_with("layers.") && name.ends_with(".weight");
-        let attention = name.contains(".attention.");
-        let ff_output = !attention && name.ends_with(".output.weight");
-        match std::env::var("COMA_INT8_EXPERIMENT").as_deref() {
-            Ok("ff") => linear && !attention,
-            Ok("attention") => linear && attention,
-            Ok("no-ff-output") => linear && !ff_output,
-            Ok("none") => false,
-            _ => linear,
-        }
+        name.starts_with("layers.") && name.ends_with(".weight")
     }
 
     /// Loads an encoder from the bytes of [`MODEL_FILE`] (the format above), widening int8
@@ -322,36 +313,7 @@ fn quantize_columns(matrix: &TensorData) -> Result<(TensorData, TensorData), Str
             *mx = mx.max(v.abs());
         }
     }
-    let mut scales: Vec<f32> = max.iter().map(|m| m / 127.0).collect();
-    if std::env::var("COMA_INT8_MSE").is_ok() {
-        // TEMP experiment: per column, the clipping of the largest value that minimises the
-        // squared error.
-        for (c, scale) in scales.iter_mut().enumerate() {
-            let column: Vec<f32> = (0..rows).map(|r| m[r * cols + c]).collect();
-            let error = |s: f32| -> f64 {
-                if s == 0.0 {
-                    return 0.0;
-                }
-                column
-                    .iter()
-                    .map(|v| {
-                        let q = (v / s).round().clamp(-127.0, 127.0);
-                        ((q * s - v) as f64).powi(2)
-                    })
-                    .sum()
-            };
-            let base = *scale;
-            let mut best = (error(base), base);
-            for k in 1..=40 {
-                let s = base * (1.0 - k as f32 * 0.0125);
-                let e = error(s);
-                if e < best.0 {
-                    best = (e, s);
-                }
-            }
-            *scale = best.1;
-        }
-    }
+    let scales: Vec<f32> = max.iter().map(|m| m / 127.0).collect();
     // An all-zero column keeps scale 0; dividing by it would give NaN.
     let inv: Vec<f32> = scales
         .iter()
