@@ -19,7 +19,8 @@ echo "== unit and integration tests (with a real local LLM server for tests/loca
 # first run on a machine compiles llama.cpp once into a wheel cache (several minutes).
 COMA_LOCAL_LLM="$(scripts/llm_server.sh)"
 export COMA_LOCAL_LLM
-trap 'scripts/llm_server.sh stop' EXIT
+# An absolute path: the trap may run after a step changed directory.
+trap "'$PWD/scripts/llm_server.sh' stop" EXIT
 cargo test --workspace --release
 scripts/llm_server.sh stop
 
