@@ -399,7 +399,7 @@ fn movements(words: &[&str], previous: Option<Action>) -> Option<Movements> {
                 a.with_side(side(words, i).unwrap_or(if lexicon::both_by_default(w) {
                     Side::Both
                 } else {
-                    default_side(a)
+                    Side::Right
                 }))
             }
             a => a,
@@ -460,13 +460,6 @@ fn same_kind(a: Action, b: Action) -> bool {
                 b,
                 Action::Walk(Direction::TurnLeft) | Action::Walk(Direction::TurnRight)
             )
-}
-
-fn default_side(action: Action) -> Side {
-    match action {
-        Action::Goodbye => Side::Right,
-        _ => Side::Right,
-    }
 }
 
 fn side_word(word: &str) -> Option<Side> {
