@@ -14,7 +14,7 @@
 //! that faces +Z; the character's left (+X) is then on the viewer's right, so world +X goes to
 //! the image's right, exactly as your friend's left hand is on your right when you face them.
 
-mod font;
+pub(crate) mod font;
 pub mod plot;
 
 use std::path::{Path, PathBuf};
@@ -973,7 +973,7 @@ fn stroke_circle(pm: &mut Pixmap, (x, y): (f32, f32), radius: f32, width: f32, c
 
 /// Draws `text` with the bitmap font, each font pixel an `s`×`s` square, top-left at `(x, y)`.
 /// Squares are snapped to whole pixels and not anti-aliased so that small text stays crisp.
-fn draw_text(pm: &mut Pixmap, text: &str, x: f32, y: f32, s: u32, c: [u8; 3]) {
+pub(crate) fn draw_text(pm: &mut Pixmap, text: &str, x: f32, y: f32, s: u32, c: [u8; 3]) {
     let mut p = paint(c, 255);
     p.anti_alias = false;
     let (x, y, s) = (x.round(), y.round(), s as f32);

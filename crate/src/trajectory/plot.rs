@@ -8,12 +8,11 @@
 //! edges. The start is a green dot, the end an arrowhead in the walking direction, the
 //! requested curve (if any) a dashed grey line.
 //!
-//! Text uses a tiny built-in capitals-only font: the renderer's font is private to
-//! [`render`](crate::render), and this picture only needs short labels.
+//! Text uses the filmstrips' bitmap font ([`render`](crate::render)).
 
+use crate::render::{draw_text, font, font::text_width};
 use tiny_skia::{
-    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash,
-    Transform,
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, StrokeDash, Transform,
 };
 
 /// Largest coordinate accepted, metres: a walking path is never this far from its start.
@@ -31,7 +30,7 @@ const LABEL_COLOR: [u8; 3] = [110, 110, 110];
 /// How to draw a path picture.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PathPlotOptions {
-    /// Text above the picture (drawn in capitals, cut to fit one line); empty for none.
+    /// Text above the picture (cut to fit one line); empty for none.
     pub title: String,
     /// Width and height of the square image in pixels, 200 to 4096.
     pub size_px: u32,
@@ -91,7 +90,7 @@ pub fn path_png(
 
     let s = (size / 320).clamp(1, 4);
     let sf = s as f32;
-    let line_h = 7.0 * sf;
+    let line_h = font::LINE_ROWS as f32 * sf;
     let pad = 10.0 * sf;
     let top = pad
         + if options.title.is_empty() {
@@ -128,7 +127,7 @@ pub fn path_png(
     draw_arrowhead(&mut pm, path, &view, 9.0 * sf);
 
     if !options.title.is_empty() {
-        let max_chars = ((size as f32 - 2.0 * pad) / (4.0 * sf * 1.5)) as usize;
+        let max_chars = ((size as f32 - 2.0 * pad) / (6.0 * sf * 1.5)) as usize;
         let title: String = options.title.chars().take(max_chars).collect();
         draw_text(&mut pm, &title, pad, pad, s + s / 2, TEXT_COLOR);
     }
@@ -285,7 +284,7 @@ fn draw_grid(pm: &mut Pixmap, view: &View, area: &Area, s: u32) {
             pm,
             &label,
             area.left - w - 3.0 * sf,
-            py - 2.5 * sf,
+            py - font::CAP_ROWS as f32 / 2.0 * sf,
             s,
             LABEL_COLOR,
         );
@@ -375,100 +374,6 @@ fn fill_circle(pm: &mut Pixmap, (x, y): (f32, f32), r: f32, c: [u8; 3]) {
             Transform::identity(),
             None,
         );
-    }
-}
-
-/// Glyphs of the label font, 5 rows of ASCII art separated by `/`, `#` for ink.
-fn glyph(c: char) -> &'static str {
-    match c.to_ascii_uppercase() {
-        '0' => "###/#.#/#.#/#.#/###",
-        '1' => ".#./##./.#./.#./###",
-        '2' => "###/..#/###/#../###",
-        '3' => "###/..#/.##/..#/###",
-        '4' => "#.#/#.#/###/..#/..#",
-        '5' => "###/#../###/..#/###",
-        '6' => "###/#../###/#.#/###",
-        '7' => "###/..#/..#/.#./.#.",
-        '8' => "###/#.#/###/#.#/###",
-        '9' => "###/#.#/###/..#/###",
-        'A' => ".#./#.#/###/#.#/#.#",
-        'B' => "##./#.#/##./#.#/##.",
-        'C' => ".##/#../#../#../.##",
-        'D' => "##./#.#/#.#/#.#/##.",
-        'E' => "###/#../##./#../###",
-        'F' => "###/#../##./#../#..",
-        'G' => ".##/#../#.#/#.#/.##",
-        'H' => "#.#/#.#/###/#.#/#.#",
-        'I' => "###/.#./.#./.#./###",
-        'J' => "..#/..#/..#/#.#/.#.",
-        'K' => "#.#/#.#/##./#.#/#.#",
-        'L' => "#../#../#../#../###",
-        'M' => "#...#/##.##/#.#.#/#...#/#...#",
-        'N' => "#..#/##.#/#.##/#..#/#..#",
-        'O' => ".#./#.#/#.#/#.#/.#.",
-        'P' => "##./#.#/##./#../#..",
-        'Q' => ".#./#.#/#.#/##./.##",
-        'R' => "##./#.#/##./#.#/#.#",
-        'S' => ".##/#../.#./..#/##.",
-        'T' => "###/.#./.#./.#./.#.",
-        'U' => "#.#/#.#/#.#/#.#/###",
-        'V' => "#.#/#.#/#.#/#.#/.#.",
-        'W' => "#...#/#...#/#.#.#/##.##/#...#",
-        'X' => "#.#/#.#/.#./#.#/#.#",
-        'Y' => "#.#/#.#/.#./.#./.#.",
-        'Z' => "###/..#/.#./#../###",
-        ' ' => "../../../../..",
-        '.' => "././././#",
-        ',' => "../../../.#/#.",
-        ':' => "./#/./#/.",
-        '-' => ".../.../###/.../...",
-        '+' => ".../.#./###/.#./...",
-        '=' => ".../###/.../###/...",
-        '_' => ".../.../.../.../###",
-        '(' => ".#/#./#./#./.#",
-        ')' => "#./.#/.#/.#/#.",
-        '/' => "..#/..#/.#./#../#..",
-        '\'' => "#/#/././.",
-        '"' => "#.#/#.#/.../.../...",
-        '!' => "#/#/#/./#",
-        '%' => "#.#/..#/.#./#../#.#",
-        _ => "###/..#/.#./.../.#.",
-    }
-}
-
-/// Font pixels between glyphs.
-const SPACING: u32 = 1;
-
-fn glyph_width(art: &str) -> u32 {
-    art.split('/').next().map_or(0, |r| r.len() as u32)
-}
-
-/// Width of `text` in font pixels.
-fn text_width(text: &str) -> u32 {
-    let total: u32 = text.chars().map(|c| glyph_width(glyph(c)) + SPACING).sum();
-    total.saturating_sub(SPACING)
-}
-
-/// Draws `text` in capitals with each font pixel an `s`×`s` square, top-left at `(x, y)`;
-/// squares are snapped to whole pixels so small text stays crisp.
-fn draw_text(pm: &mut Pixmap, text: &str, x: f32, y: f32, s: u32, c: [u8; 3]) {
-    let mut p = paint(c);
-    p.anti_alias = false;
-    let (mut x, y, s) = (x.round(), y.round(), s as f32);
-    for ch in text.chars() {
-        let art = glyph(ch);
-        for (row, line) in art.split('/').enumerate() {
-            for (col, b) in line.bytes().enumerate() {
-                if b != b'#' {
-                    continue;
-                }
-                let rect = Rect::from_xywh(x + col as f32 * s, y + row as f32 * s, s, s);
-                if let Some(rect) = rect {
-                    pm.fill_rect(rect, &p, Transform::identity(), None);
-                }
-            }
-        }
-        x += (glyph_width(art) + SPACING) as f32 * s;
     }
 }
 
@@ -573,15 +478,7 @@ mod tests {
     }
 
     #[test]
-    fn glyphs_are_rectangular() {
-        for c in (' '..='~').chain(['é']) {
-            let art = glyph(c);
-            let rows: Vec<&str> = art.split('/').collect();
-            assert_eq!(rows.len(), 5, "{c:?}");
-            assert!(rows.iter().all(|r| r.len() == rows[0].len()), "{c:?}");
-        }
-        assert_eq!(text_width("1"), 3);
-        assert_eq!(text_width("11"), 7);
+    fn ticks_are_short_and_steps_nice() {
         assert_eq!(format_tick(0.5, 0.5), "0.5");
         assert_eq!(format_tick(-2.0, 1.0), "-2");
         assert_eq!(nice_step(0.3), 0.5);
