@@ -45,7 +45,7 @@ pub fn run_bench(
         unit,
     };
     let (spam, load) = match config {
-        Some(c) => seconds_of(|| Spam::random(&c.vq, &c.base, &c.residual, &device)),
+        Some(c) => seconds_of(|| Spam::random(&c.vq, &c.base, c.residual.as_ref(), &device)),
         None => {
             let (loaded, t) = seconds_of(|| Spam::load(models, &device));
             (loaded?.0, t)
@@ -62,11 +62,13 @@ pub fn run_bench(
         spam.base.num_params() as f64 / 1e6,
         "M",
     ));
-    rows.push(row(
-        "parameters: residual transformer",
-        spam.residual.num_params() as f64 / 1e6,
-        "M",
-    ));
+    if let Some(residual) = &spam.residual {
+        rows.push(row(
+            "parameters: residual transformer",
+            residual.network.num_params() as f64 / 1e6,
+            "M",
+        ));
+    }
     let (text, load_text) = seconds_of(|| SentenceEncoder::from_dir(models, &device));
     let text = text?;
     rows.push(row("load sentence encoder", load_text * 1e3, "ms"));
@@ -87,16 +89,15 @@ pub fn run_bench(
     ));
     let (tokens, t) =
         seconds_of(|| spam.decode_residual(&condition, base, None, &options, &mut rng));
-    rows.push(row("residual tokens, 196 frames", t * 1e3, "ms"));
+    if spam.residual.is_some() {
+        rows.push(row("residual tokens, 196 frames", t * 1e3, "ms"));
+    }
     let (_, t) = seconds_of(|| spam.decode(&tokens));
     rows.push(row("decode tokens to features", t * 1e3, "ms"));
 
     let sizes = config.cloned().unwrap_or_else(|| {
-        SpamConfig::new(
-            spam.vq_config.clone(),
-            spam.base_config.clone(),
-            spam.residual_config.clone(),
-        )
+        SpamConfig::new(spam.vq_config.clone(), spam.base_config.clone())
+            .with_residual(spam.residual.as_ref().map(|r| r.config.clone()))
     });
     rows.push(row(
         "train VQ-VAE (batch 64 × 64 frames)",
@@ -109,11 +110,13 @@ pub fn run_bench(
         b,
         "samples/s",
     ));
-    rows.push(row(
-        "train residual transformer (batch 64 × 196 frames)",
-        r,
-        "samples/s",
-    ));
+    if let Some(r) = r {
+        rows.push(row(
+            "train residual transformer (batch 64 × 196 frames)",
+            r,
+            "samples/s",
+        ));
+    }
     Ok(rows)
 }
 
@@ -143,8 +146,9 @@ fn train_vq_rate(config: &SpamConfig, steps: usize) -> f64 {
     64.0 * steps as f64 / elapsed
 }
 
-/// Samples per second of base and residual training steps on random tokens.
-fn train_transformer_rates(config: &SpamConfig, steps: usize) -> (f64, f64) {
+/// Samples per second of base and (when the sizes have one) residual training steps on
+/// random tokens.
+fn train_transformer_rates(config: &SpamConfig, steps: usize) -> (f64, Option<f64>) {
     let device = Device::flex().autodiff();
     let (b, n) = (64, 49);
     let k = config.base.codebook_size as i32;
@@ -171,8 +175,10 @@ fn train_transformer_rates(config: &SpamConfig, steps: usize) -> (f64, f64) {
             .forward(logits.reshape([bb * p * nn, kk]), targets.clone())
     };
     let mut base = crate::model::transformer::BaseTransformer::new(&config.base, &device);
-    let mut residual =
-        crate::model::transformer::ResidualTransformer::new(&config.residual, &device);
+    let mut residual = config
+        .residual
+        .as_ref()
+        .map(|c| crate::model::transformer::ResidualTransformer::new(c, &device));
     let mut optim = AdamWConfig::new().init();
     let mut optim_r = AdamWConfig::new().init();
     let (mut tb, mut tr) = (0.0, 0.0);
@@ -185,17 +191,21 @@ fn train_transformer_rates(config: &SpamConfig, steps: usize) -> (f64, f64) {
         if i > 0 {
             tb += start.elapsed().as_secs_f64();
         }
+        let Some(net) = residual.take() else {
+            continue;
+        };
         let lower =
             Tensor::<4, Int>::from_data(TensorData::new(tokens(2), [b, PARTS, 2, n]), &device);
         let start = Instant::now();
-        let loss = ce(residual.forward(lower, 2, text(), keep(), pad()));
-        let grads = GradientsParams::from_grads(loss.backward(), &residual);
-        residual = optim_r.step(1e-4, residual, grads);
+        let loss = ce(net.forward(lower, 2, text(), keep(), pad()));
+        let grads = GradientsParams::from_grads(loss.backward(), &net);
+        residual = Some(optim_r.step(1e-4, net, grads));
         if i > 0 {
             tr += start.elapsed().as_secs_f64();
         }
     }
-    (b as f64 * steps as f64 / tb, b as f64 * steps as f64 / tr)
+    let rate = |t: f64| b as f64 * steps as f64 / t;
+    (rate(tb), residual.map(|_| rate(tr)))
 }
 
 /// The rows as a Markdown table.

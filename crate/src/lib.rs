@@ -22,3 +22,4 @@ pub mod skeleton;
 pub mod text;
 pub mod train;
 pub mod trajectory;
+pub mod weights;

@@ -16,22 +16,17 @@ use coma::dataset::Vocabulary;
 use coma::eval::evaluator::{Evaluator, EvaluatorConfig};
 use coma::model::generate::MotionTokens;
 use coma::model::motion_model::{frames_for_seconds, TextFiles};
-use coma::model::{MotionModel, SpamFiles};
+use coma::model::{MotionModel, SpamConfig, SpamFiles, RESIDUAL_FILE};
 use coma::skeleton::BodyPart;
+use coma::text::minilm::{MODEL_FILE, VOCAB_FILE, WORDS_FILE};
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{DedicatedWorkerGlobalScope, MessageEvent};
 
-/// The files of the default model, in the order they are fetched: SPAM's, then the sentence
-/// encoder's.
-fn model_files() -> Vec<&'static str> {
-    use coma::text::minilm::{MODEL_FILE, VOCAB_FILE, WORDS_FILE};
-    let mut files = coma::model::WEIGHT_FILES.to_vec();
-    files.extend([VOCAB_FILE, WORDS_FILE, MODEL_FILE]);
-    files
-}
+/// The sentence encoder's files, fetched after SPAM's.
+const TEXT_FILES: [&str; 3] = [VOCAB_FILE, WORDS_FILE, MODEL_FILE];
 
 /// The agents' files, fetched after the model: the page works without them, with less.
 const EVALUATOR_FILES: [&str; 2] = ["evaluator.json", "evaluator.bpk"];
@@ -103,10 +98,27 @@ async fn fetch(url: &str) -> Result<Vec<u8>, String> {
 async fn load(base: &str) -> Result<Reply, String> {
     let started = now();
     let base = base.trim_end_matches('/');
-    let names = model_files();
-    let total = (names.len() + EVALUATOR_FILES.len() + 1) as u64;
-    let mut done = 0u64;
-    let mut bytes = 0u64;
+    let not_here = |e: String| {
+        format!(
+            "The motion model is not on this server ({e}). See README.md for how to serve it \
+             with the page."
+        )
+    };
+    // spam.json says which weight files the model has (a base-only model has no residual
+    // transformer), so it comes first.
+    let config_bytes = fetch(&format!("{base}/spam.json"))
+        .await
+        .map_err(not_here)?;
+    let sizes: SpamConfig = serde_json::from_slice(&config_bytes)
+        .map_err(|e| format!("spam.json on this server is not a model's sizes: {e}"))?;
+    let names: Vec<&str> = sizes.weight_files()[1..]
+        .iter()
+        .copied()
+        .chain(TEXT_FILES)
+        .collect();
+    let total = (names.len() + 1 + EVALUATOR_FILES.len() + 1) as u64;
+    let mut done = 1u64;
+    let mut bytes = config_bytes.len() as u64;
     let mut download = async |name: &str| {
         post(&Reply::Progress {
             stage: format!("downloading the model: {name}"),
@@ -118,19 +130,9 @@ async fn load(base: &str) -> Result<Reply, String> {
         bytes += data.len() as u64;
         Ok::<_, String>(data)
     };
-    let mut files = Vec::with_capacity(names.len());
-    for (i, name) in names.iter().copied().enumerate() {
-        let data = download(name).await.map_err(|e| {
-            if i == 0 {
-                format!(
-                    "The motion model is not on this server ({e}). Its default weights are still \
-                     being trained: see README.md and MODEL_CARD.md."
-                )
-            } else {
-                e
-            }
-        })?;
-        files.push(data);
+    let mut files = std::collections::HashMap::new();
+    for name in names {
+        files.insert(name, download(name).await?);
     }
     // Optional: a failure here costs the review or the LLM planner, not the page.
     let evaluator_files = [
@@ -143,25 +145,28 @@ async fn load(base: &str) -> Result<Reply, String> {
         done: total,
         total,
     });
-    let text = |i: usize| {
-        std::str::from_utf8(&files[i]).map_err(|_| format!("{} is not UTF-8 text", names[i]))
+    let file = |name: &str| files.get(name).map(Vec::as_slice).unwrap_or_default();
+    let text = |name: &str| {
+        std::str::from_utf8(file(name)).map_err(|_| format!("{name} is not UTF-8 text"))
     };
+    let config = std::str::from_utf8(&config_bytes)
+        .map_err(|_| "spam.json is not UTF-8 text".to_string())?;
     // The models run on the CPU backend: generation reads logits back synchronously, which
     // WebGPU in a browser cannot do.
     let device = burn::tensor::Device::flex();
     let model = MotionModel::from_files(
         &SpamFiles {
-            config: text(0)?,
-            vq: &files[1],
-            base: &files[2],
-            residual: &files[3],
-            mean: &files[4],
-            std: &files[5],
+            config,
+            vq: file("vq.bpk"),
+            base: file("base.bpk"),
+            residual: files.get(RESIDUAL_FILE).map(Vec::as_slice),
+            mean: file("mean.npy"),
+            std: file("std.npy"),
         },
         &TextFiles {
-            vocab: text(6)?,
-            words: &files[7],
-            model: &files[8],
+            vocab: text(VOCAB_FILE)?,
+            words: file(WORDS_FILE),
+            model: file(MODEL_FILE),
         },
         &device,
     )

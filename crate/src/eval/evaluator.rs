@@ -271,14 +271,8 @@ impl Evaluator {
         };
         let config: EvaluatorConfig =
             serde_json::from_str(config).map_err(|e| error("evaluator.json", e.to_string()))?;
-        let record = burn::store::ModuleRecord::from_bytes(burn::tensor::Bytes::from_bytes_vec(
-            weights.to_vec(),
-        ))
-        .map_err(|e| error("evaluator.bpk", format!("{e:?}")))?;
-        let model = config
-            .init(device)
-            .try_load_record(record.cast_to_module_dtype())
-            .map_err(|e| error("evaluator.bpk", format!("{e:?}")))?;
+        let model = crate::weights::load_into(config.init(device), weights)
+            .map_err(|e| error("evaluator.bpk", e))?;
         Ok((model, config))
     }
 
@@ -321,22 +315,7 @@ impl Evaluator {
     /// the same weights always give the same bytes. [`Self::from_bytes`] and [`Self::load`]
     /// read it back as f32.
     pub fn to_f16_bytes(&self) -> anyhow::Result<Vec<u8>> {
-        use burn::store::{bridge, burn_pack, ModuleSnapshot};
-        let mut tensors = Vec::new();
-        for tensor in self.collect(None, None, false) {
-            let name = tensor.name.clone();
-            let data = bridge::into_data(tensor).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
-            let data = if data.dtype().is_float() {
-                data.convert_dtype(burn::tensor::DType::F16)
-            } else {
-                data
-            };
-            tensors.push(bridge::from_data(data, name, None));
-        }
-        let bytes = burn_pack::Writer::new(tensors)
-            .into_bytes()
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
-        Ok(bytes.to_vec())
+        crate::weights::f16_bytes(self)
     }
 }
 

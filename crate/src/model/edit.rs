@@ -216,7 +216,7 @@ mod tests {
     use crate::model::generate::tests::{small, tiny_vq};
 
     fn spam() -> Spam {
-        Spam::random(&tiny_vq(), &small(), &small(), &Device::flex())
+        Spam::random(&tiny_vq(), &small(), Some(&small()), &Device::flex())
     }
 
     #[test]

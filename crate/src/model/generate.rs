@@ -3,7 +3,7 @@
 //! motion on every backend.
 
 use super::transformer::{PARTS, TEXT_DIM};
-use super::Spam;
+use super::{Residual, Spam};
 use crate::rng::Rng;
 use burn::prelude::*;
 use burn::tensor::{Bool, Int, TensorData};
@@ -179,7 +179,8 @@ impl Spam {
     }
 
     /// Predicts residual layers `1..layers` from layer 0 (`[part][step]`); positions that `keep`
-    /// marks as not editable take the original tokens. Returns `[part][layer][step]`.
+    /// marks as not editable take the original tokens. Returns `[part][layer][step]`, with
+    /// layer 0 alone for a base-only model.
     pub fn decode_residual(
         &self,
         text: &[[f32; TEXT_DIM]; PARTS],
@@ -188,11 +189,18 @@ impl Spam {
         options: &SamplingOptions,
         rng: &mut Rng,
     ) -> MotionTokens {
-        let (model, config, device) = (&self.residual, &self.residual_config, &self.device);
-        let n = base[0].len();
+        let mut layers: MotionTokens = base.into_iter().map(|b| vec![b]).collect();
+        let Some(Residual {
+            network: model,
+            config,
+        }) = &self.residual
+        else {
+            return layers;
+        };
+        let device = &self.device;
+        let n = layers[0][0].len();
         let k = config.codebook_size;
         let (text_t, keep_text, pad) = conditions(text, n, device);
-        let mut layers: MotionTokens = base.into_iter().map(|b| vec![b]).collect();
         for j in 1..config.vq_layers {
             let mut flat = Vec::with_capacity(2 * PARTS * j * n);
             for _ in 0..2 {
@@ -288,7 +296,7 @@ pub(crate) mod tests {
 
     #[test]
     fn same_seed_same_tokens_and_fixed_tokens_stay() {
-        let spam = Spam::random(&tiny_vq(), &small(), &small(), &Device::flex());
+        let spam = Spam::random(&tiny_vq(), &small(), Some(&small()), &Device::flex());
         let text = [[0.1f32; TEXT_DIM]; PARTS];
         let mut fixed = vec![vec![None; 6]; PARTS];
         fixed[2][0] = Some(7);
@@ -312,5 +320,20 @@ pub(crate) mod tests {
             a.iter().flatten().flatten().all(|t| *t < 16),
             "no mask or pad ids in the output"
         );
+    }
+
+    #[test]
+    fn a_base_only_model_generates_layer_zero() {
+        let spam = Spam::random(&tiny_vq(), &small(), None, &Device::flex());
+        assert_eq!(spam.generated_layers(), 1);
+        let text = [[0.1f32; TEXT_DIM]; PARTS];
+        let options = SamplingOptions::default();
+        let mut rng = Rng::new(1);
+        let b = spam.decode_base(&text, &vec![vec![None; 6]; PARTS], &options, &mut rng);
+        let tokens = spam.decode_residual(&text, b.clone(), None, &options, &mut rng);
+        assert_eq!(tokens.len(), PARTS);
+        for (part, base) in tokens.iter().zip(&b) {
+            assert_eq!(part, &vec![base.clone()], "one layer, the base tokens");
+        }
     }
 }

@@ -14,58 +14,93 @@ use vq::{MotionVq, VqConfig};
 
 use burn::prelude::*;
 
-/// The three networks of SPAM on one device, ready to generate.
+/// The networks of SPAM on one device, ready to generate.
 #[derive(Debug)]
 pub struct Spam {
     pub vq: MotionVq,
     pub vq_config: VqConfig,
     pub base: BaseTransformer,
-    pub residual: ResidualTransformer,
     pub base_config: TransformerConfig,
-    pub residual_config: TransformerConfig,
+    /// Absent in a base-only model, whose motions decode from the layer-0 tokens alone
+    /// (coarser: see MODEL_CARD.md for the reconstruction error of one layer).
+    pub residual: Option<Residual>,
     pub device: Device,
 }
 
+/// The residual transformer and its sizes.
+#[derive(Debug)]
+pub struct Residual {
+    pub network: ResidualTransformer,
+    pub config: TransformerConfig,
+}
+
 impl Spam {
-    /// SPAM with random weights (tests, benchmarks at a given size).
+    /// SPAM with random weights (tests, benchmarks at a given size); base-only without
+    /// `residual`.
     pub fn random(
         vq: &VqConfig,
         base: &TransformerConfig,
-        residual: &TransformerConfig,
+        residual: Option<&TransformerConfig>,
         device: &Device,
     ) -> Spam {
         Spam {
             vq: vq.init(device),
             vq_config: vq.clone(),
             base: BaseTransformer::new(base, device),
-            residual: ResidualTransformer::new(residual, device),
             base_config: base.clone(),
-            residual_config: residual.clone(),
+            residual: residual.map(|config| Residual {
+                network: ResidualTransformer::new(config, device),
+                config: config.clone(),
+            }),
             device: device.clone(),
+        }
+    }
+
+    /// Token layers per body part that generation produces: all of the VQ-VAE's with the
+    /// residual transformer, 1 without.
+    pub fn generated_layers(&self) -> usize {
+        match &self.residual {
+            Some(r) => r.config.vq_layers,
+            None => 1,
         }
     }
 }
 
-/// Sizes of the three networks, stored beside their weights as `spam.json`.
+/// Sizes of SPAM's networks, stored beside their weights as `spam.json`. A model without a
+/// residual transformer (`"residual": null`) is base-only.
 #[derive(Config, Debug)]
 pub struct SpamConfig {
     pub vq: VqConfig,
     pub base: TransformerConfig,
-    pub residual: TransformerConfig,
+    pub residual: Option<TransformerConfig>,
 }
 
-/// The weight files of a SPAM model folder, in the order its id hashes them.
+impl SpamConfig {
+    /// The model folder's files for these sizes, in the order its id hashes them: every one
+    /// of [`WEIGHT_FILES`] but `residual.bpk` for a base-only model.
+    pub fn weight_files(&self) -> Vec<&'static str> {
+        WEIGHT_FILES
+            .into_iter()
+            .filter(|f| *f != RESIDUAL_FILE || self.residual.is_some())
+            .collect()
+    }
+}
+
+/// Every weight file a SPAM model folder may hold, in the order its id hashes them.
 pub const WEIGHT_FILES: [&str; 6] = [
     "spam.json",
     "vq.bpk",
     "base.bpk",
-    "residual.bpk",
+    RESIDUAL_FILE,
     "mean.npy",
     "std.npy",
 ];
 
+/// The residual transformer's weights: the one file a base-only model lacks.
+pub const RESIDUAL_FILE: &str = "residual.bpk";
+
 /// A model's id: the first 16 hex digits of the SHA-256 of its weight files, in
-/// [`WEIGHT_FILES`] order. Share links name the model they were made with by this id.
+/// [`SpamConfig::weight_files`] order. Share links name the model they were made with by this id.
 pub fn model_id(files: &[&[u8]]) -> String {
     use sha2::{Digest, Sha256};
     let mut hash = Sha256::new();
@@ -108,9 +143,20 @@ pub struct SpamFiles<'a> {
     pub config: &'a str,
     pub vq: &'a [u8],
     pub base: &'a [u8],
-    pub residual: &'a [u8],
+    /// `None` for a base-only model.
+    pub residual: Option<&'a [u8]>,
     pub mean: &'a [u8],
     pub std: &'a [u8],
+}
+
+impl SpamFiles<'_> {
+    /// The model id of these files (see [`model_id`]).
+    pub fn id(&self) -> String {
+        let mut files: Vec<&[u8]> = vec![self.config.as_bytes(), self.vq, self.base];
+        files.extend(self.residual);
+        files.extend([self.mean, self.std]);
+        model_id(&files)
+    }
 }
 
 impl Spam {
@@ -126,60 +172,69 @@ impl Spam {
         };
         let config: SpamConfig =
             serde_json::from_str(files.config).map_err(|e| error("spam.json", e.to_string()))?;
-        let mut spam = Spam::random(&config.vq, &config.base, &config.residual, device);
-        let record = |name: &str, bytes: &[u8]| {
-            burn::store::ModuleRecord::from_bytes(burn::tensor::Bytes::from_bytes_vec(
-                bytes.to_vec(),
-            ))
-            .map_err(|e| error(name, format!("{e:?}")))
-        };
-        spam.vq = spam
-            .vq
-            .try_load_record(record("vq.bpk", files.vq)?)
-            .map_err(|e| error("vq.bpk", format!("{e:?}")))?;
-        spam.base = spam
-            .base
-            .try_load_record(record("base.bpk", files.base)?)
-            .map_err(|e| error("base.bpk", format!("{e:?}")))?;
-        spam.residual = spam
-            .residual
-            .try_load_record(record("residual.bpk", files.residual)?)
-            .map_err(|e| error("residual.bpk", format!("{e:?}")))?;
+        let mut spam = Spam::random(&config.vq, &config.base, config.residual.as_ref(), device);
+        spam.vq = crate::weights::load_into(spam.vq, files.vq).map_err(|e| error("vq.bpk", e))?;
+        spam.base =
+            crate::weights::load_into(spam.base, files.base).map_err(|e| error("base.bpk", e))?;
+        match (spam.residual.as_mut(), files.residual) {
+            (Some(residual), Some(bytes)) => {
+                residual.network = crate::weights::load_into(residual.network.clone(), bytes)
+                    .map_err(|e| error(RESIDUAL_FILE, e))?;
+            }
+            (Some(_), None) => {
+                return Err(error(
+                    RESIDUAL_FILE,
+                    "missing, but spam.json sizes a residual transformer".into(),
+                ))
+            }
+            (None, Some(_)) => {
+                return Err(error(
+                    RESIDUAL_FILE,
+                    "present, but spam.json has no residual transformer (\"residual\": null)"
+                        .into(),
+                ))
+            }
+            (None, None) => {}
+        }
         let normalizer = crate::features::Normalizer::from_npy_bytes(files.mean, files.std)
             .map_err(|e| error("mean.npy/std.npy", e.to_string()))?;
         Ok((spam, normalizer))
     }
 
-    /// Loads `spam.json`, `vq.bpk`, `base.bpk`, `residual.bpk` and the feature statistics
-    /// `mean.npy`/`std.npy` from a folder (the default model lives in `static/models`).
+    /// Loads `spam.json`, `vq.bpk`, `base.bpk`, `residual.bpk` (unless base-only) and the
+    /// feature statistics `mean.npy`/`std.npy` from a folder (the default model lives in
+    /// `static/models`). Returns the model id too.
     pub fn load(
         dir: &std::path::Path,
         device: &Device,
-    ) -> Result<(Spam, crate::features::Normalizer), SpamLoadError> {
+    ) -> Result<(Spam, crate::features::Normalizer, String), SpamLoadError> {
         let read =
             |name: &str| std::fs::read(dir.join(name)).map_err(|e| load_error(&dir.join(name), e));
-        let bytes: Vec<Vec<u8>> = WEIGHT_FILES
-            .iter()
-            .map(|f| read(f))
-            .collect::<Result<_, _>>()?;
-        let config =
-            std::str::from_utf8(&bytes[0]).map_err(|e| load_error(&dir.join("spam.json"), e))?;
-        Spam::from_bytes(
-            &SpamFiles {
-                config,
-                vq: &bytes[1],
-                base: &bytes[2],
-                residual: &bytes[3],
-                mean: &bytes[4],
-                std: &bytes[5],
-            },
-            device,
-        )
-        .map_err(
-            |SpamLoadError::File { file, message }| SpamLoadError::File {
-                file: dir.join(file).display().to_string(),
-                message,
-            },
-        )
+        let config_bytes = read("spam.json")?;
+        let config = std::str::from_utf8(&config_bytes)
+            .map_err(|e| load_error(&dir.join("spam.json"), e))?;
+        let residual = match serde_json::from_str::<SpamConfig>(config) {
+            Ok(sizes) if sizes.residual.is_none() => None,
+            // A damaged spam.json is reported by `from_bytes`.
+            _ => Some(read(RESIDUAL_FILE)?),
+        };
+        let (vq, base) = (read("vq.bpk")?, read("base.bpk")?);
+        let (mean, std) = (read("mean.npy")?, read("std.npy")?);
+        let files = SpamFiles {
+            config,
+            vq: &vq,
+            base: &base,
+            residual: residual.as_deref(),
+            mean: &mean,
+            std: &std,
+        };
+        let (spam, normalizer) =
+            Spam::from_bytes(&files, device).map_err(|SpamLoadError::File { file, message }| {
+                SpamLoadError::File {
+                    file: dir.join(file).display().to_string(),
+                    message,
+                }
+            })?;
+        Ok((spam, normalizer, files.id()))
     }
 }

@@ -4,7 +4,7 @@
 
 use super::edit::{part_text, PartText};
 use super::generate::{MotionTokens, SamplingOptions};
-use super::{Spam, SpamFiles, SpamLoadError, WEIGHT_FILES};
+use super::{Spam, SpamFiles, SpamLoadError};
 use crate::features::{features_to_joints, Features, Normalizer, FPS};
 use crate::skeleton::{BodyPart, Pose};
 use crate::text::minilm::{MiniLmError, SentenceEncoder};
@@ -48,14 +48,7 @@ impl MotionModel {
         text: &TextFiles,
         device: &Device,
     ) -> Result<MotionModel, MotionModelError> {
-        let id = super::model_id(&[
-            spam.config.as_bytes(),
-            spam.vq,
-            spam.base,
-            spam.residual,
-            spam.mean,
-            spam.std,
-        ]);
+        let id = spam.id();
         let (spam, normalizer) = Spam::from_bytes(spam, device)?;
         let text = SentenceEncoder::from_bytes(text.vocab, text.words, text.model, device)?;
         Ok(MotionModel {
@@ -68,10 +61,8 @@ impl MotionModel {
 
     /// The model in a folder (the default one is `static/models`).
     pub fn load(dir: &std::path::Path, device: &Device) -> Result<MotionModel, MotionModelError> {
-        let (spam, normalizer) = Spam::load(dir, device)?;
+        let (spam, normalizer, id) = Spam::load(dir, device)?;
         let text = SentenceEncoder::from_dir(dir, device)?;
-        let id = super::model_id_of_dir(dir, &WEIGHT_FILES)
-            .map_err(|e| MotionModelError::Io(format!("{}: {e}", dir.display())))?;
         Ok(MotionModel {
             spam,
             normalizer,

@@ -23,6 +23,14 @@ pub struct RunState {
     pub samples: u64,
 }
 
+impl RunState {
+    /// The state of a run folder's latest checkpoint, if it has a readable one.
+    pub fn of(dir: &Path) -> Option<RunState> {
+        let text = std::fs::read_to_string(dir.join("checkpoint").join("state.json")).ok()?;
+        serde_json::from_str(&text).ok()
+    }
+}
+
 /// When a loop checkpoints and stops: its total steps, minutes between checkpoints, and this
 /// session's time limit in minutes.
 #[derive(Clone, Copy, Debug)]

@@ -26,7 +26,7 @@ pub struct TokenItem {
 }
 
 /// Token items plus the embeddings of every text they use.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct TokenSet {
     pub items: Vec<TokenItem>,
     pub texts: Vec<String>,

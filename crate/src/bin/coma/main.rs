@@ -131,9 +131,10 @@ enum Command {
         /// Base transformer run folder.
         #[arg(long, default_value = "runs/base")]
         base: PathBuf,
-        /// Residual transformer run folder.
-        #[arg(long, default_value = "runs/res")]
-        res: PathBuf,
+        /// Residual transformer run folder; without it the model is base-only (its motions
+        /// decode from the layer-0 tokens alone).
+        #[arg(long)]
+        res: Option<PathBuf>,
         /// Dataset whose Mean.npy/Std.npy normalised the training data (for the evaluator:
         /// whose test split shows what rounding to f16 changes).
         #[arg(long, default_value = "data/bandai")]
@@ -552,7 +553,6 @@ pub(crate) fn write_outputs(
 /// Tokenizes the dataset with the trained VQ-VAE, embeds its texts, and trains a transformer.
 fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs) -> Result<()> {
     use burn::config::Config;
-    use burn::module::Module;
     use coma::train::transformer::{Kind, TransformerTrainOptions, TransformerTrainingConfig};
     let name = if kind == Kind::Base { "base" } else { "res" };
     let run = args
@@ -574,17 +574,20 @@ fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs
     let plain = burn::tensor::Device::flex();
     let vq_cfg = coma::train::vq::VqTrainingConfig::load(&args.vq_config)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", args.vq_config.display()))?;
-    let vq = vq_cfg
-        .model
-        .init(&plain)
-        .try_load_file(&args.vq)
-        .map_err(|e| anyhow::anyhow!("cannot load the VQ-VAE from {}: {e:?}", args.vq.display()))?;
-    let text = coma::text::minilm::SentenceEncoder::from_dir(&args.text_model, &plain)?;
-    let set = coma::train::motions::MotionSet::load(&args.data, coma::dataset::Split::Train)?;
-    let tokens =
+    let vq = coma::weights::load_file(vq_cfg.model.init(&plain), &args.vq)
+        .context("cannot load the VQ-VAE")?;
+    // A run whose checkpoint has reached its (possibly lowered) step count only writes its
+    // final weights: no need to tokenize the dataset for that.
+    let finished = coma::train::run::RunState::of(&run).is_some_and(|s| s.step >= cfg.steps);
+    let tokens = if finished {
+        coma::train::tokens::TokenSet::default()
+    } else {
+        let text = coma::text::minilm::SentenceEncoder::from_dir(&args.text_model, &plain)?;
+        let set = coma::train::motions::MotionSet::load(&args.data, coma::dataset::Split::Train)?;
         coma::train::tokens::TokenSet::build(&set, &vq, &plain, &|t| Ok(text.encode(t)), &|l| {
             println!("{l}")
-        })?;
+        })?
+    };
     let options = TransformerTrainOptions {
         run_dir: run,
         minutes: args.minutes,
@@ -639,6 +642,128 @@ fn evaluate_agents(
         }
     }
     Ok(figures)
+}
+
+/// `coma export spam`: the runs' final weights rounded to f16 into `out` with `spam.json` and
+/// the feature statistics, and what the rounding changes: the VQ-VAE's reconstruction error
+/// on 200 test motions of `data` and the tokens greedy decoding picks for a few prompts.
+fn export_spam(
+    vq: &std::path::Path,
+    base: &std::path::Path,
+    res: Option<&std::path::Path>,
+    data: &std::path::Path,
+    out: &std::path::Path,
+) -> Result<()> {
+    use burn::config::Config;
+    use coma::train::transformer::TransformerTrainingConfig;
+    let read = |p: std::path::PathBuf| std::fs::read(&p).with_context(|| p.display().to_string());
+    let transformer = |run: &std::path::Path| {
+        TransformerTrainingConfig::load(run.join("config.json"))
+            .map(|c| c.model)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", run.join("config.json").display()))
+    };
+    let sizes = coma::model::SpamConfig::new(
+        coma::train::vq::VqTrainingConfig::load(vq.join("config.json"))
+            .map_err(|e| anyhow::anyhow!("{}: {e}", vq.join("config.json").display()))?
+            .model,
+        transformer(base)?,
+    )
+    .with_residual(res.map(transformer).transpose()?);
+    let config = serde_json::to_string_pretty(&sizes)?;
+    let (vq_bytes, base_bytes) = (read(vq.join("vq.bpk"))?, read(base.join("base.bpk"))?);
+    let res_bytes = res.map(|r| read(r.join("residual.bpk"))).transpose()?;
+    let (mean, std) = (read(data.join("Mean.npy"))?, read(data.join("Std.npy"))?);
+    let device = burn::tensor::Device::flex();
+    let files = coma::model::SpamFiles {
+        config: &config,
+        vq: &vq_bytes,
+        base: &base_bytes,
+        residual: res_bytes.as_deref(),
+        mean: &mean,
+        std: &std,
+    };
+    let (full, _) = coma::model::Spam::from_bytes(&files, &device)?;
+
+    std::fs::create_dir_all(out)?;
+    let write = |name: &str, bytes: &[u8]| {
+        std::fs::write(out.join(name), bytes).with_context(|| out.join(name).display().to_string())
+    };
+    write("spam.json", config.as_bytes())?;
+    write("vq.bpk", &coma::weights::f16_bytes(&full.vq)?)?;
+    write("base.bpk", &coma::weights::f16_bytes(&full.base)?)?;
+    match &full.residual {
+        Some(r) => write(
+            coma::model::RESIDUAL_FILE,
+            &coma::weights::f16_bytes(&r.network)?,
+        )?,
+        // A stale residual file would make the folder fail to load.
+        None => match std::fs::remove_file(out.join(coma::model::RESIDUAL_FILE)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e)?,
+            _ => {}
+        },
+    }
+    write("mean.npy", &mean)?;
+    write("std.npy", &std)?;
+    let (half, _, id) = coma::model::Spam::load(out, &device)?;
+    let bytes: u64 = sizes
+        .weight_files()
+        .iter()
+        .map(|f| std::fs::metadata(out.join(f)).map_or(0, |m| m.len()))
+        .sum();
+    println!(
+        "exported SPAM ({}) into {}: f16, {bytes} bytes, model id {id}",
+        if half.residual.is_some() {
+            "with its residual transformer"
+        } else {
+            "base-only"
+        },
+        out.display()
+    );
+
+    let test = coma::train::motions::MotionSet::load(data, coma::dataset::Split::Test)?;
+    let layers = half.generated_layers();
+    let error = |spam: &coma::model::Spam| {
+        coma::train::vq::reconstruction_errors(&spam.vq, &test, &device, 200, layers)
+    };
+    let (e32, e16) = (error(&full)?, error(&half)?);
+    println!(
+        "VQ-VAE on {} test motions, {layers} of {} layers: {:.2} mm (f32) -> {:.2} mm (f16), root aligned",
+        e32.motions, sizes.vq.layers, e32.root_aligned_mm, e16.root_aligned_mm
+    );
+    let text = coma::text::minilm::SentenceEncoder::from_dir(out, &device)?;
+    let (mut same, mut total) = (0usize, 0usize);
+    for (i, prompt) in [
+        "a person walks forward",
+        "a person waves the left hand",
+        "a person raises the right hand",
+        "a person bows",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let condition = [text.encode(&[prompt])[0]; coma::model::transformer::PARTS];
+        // Greedy: sampling would turn the smallest change of a probability into another
+        // code, and every later step would follow it.
+        let options = coma::model::generate::SamplingOptions {
+            seed: i as u64,
+            temperature: 0.0,
+            ..Default::default()
+        };
+        let [a, b] = [&full, &half].map(|spam| spam.generate(&condition, 196, &options));
+        for (x, y) in a
+            .iter()
+            .flatten()
+            .flatten()
+            .zip(b.iter().flatten().flatten())
+        {
+            same += (x == y) as usize;
+            total += 1;
+        }
+    }
+    println!(
+        "greedily decoded tokens of 4 prompts (196 frames): {same} of {total} the same with f16 as with f32"
+    );
+    Ok(())
 }
 
 /// `coma export evaluator`: the run's weights rounded to f16 into `out`, and what the rounding
@@ -1153,7 +1278,8 @@ fn run(cli: Cli) -> Result<()> {
             let sizes = coma::model::SpamConfig::load("configs/spam.json")
                 .map_err(|e| anyhow::anyhow!("configs/spam.json: {e}"))?;
             let device = burn::tensor::Device::flex();
-            let spam = coma::model::Spam::random(&sizes.vq, &sizes.base, &sizes.residual, &device);
+            let spam =
+                coma::model::Spam::random(&sizes.vq, &sizes.base, sizes.residual.as_ref(), &device);
             std::fs::create_dir_all(&out)?;
             sizes
                 .save(out.join("spam.json"))
@@ -1166,10 +1292,12 @@ fn run(cli: Cli) -> Result<()> {
                 spam.base.clone().save_file(out.join("base.bpk")),
                 "base.bpk",
             )?;
-            save(
-                spam.residual.clone().save_file(out.join("residual.bpk")),
-                "residual.bpk",
-            )?;
+            if let Some(residual) = &spam.residual {
+                save(
+                    residual.network.clone().save_file(out.join("residual.bpk")),
+                    "residual.bpk",
+                )?;
+            }
             for (from, to) in [("Mean.npy", "mean.npy"), ("Std.npy", "std.npy")] {
                 std::fs::copy(data.join(from), out.join(to))
                     .with_context(|| format!("copying {}", data.join(from).display()))?;
@@ -1220,39 +1348,7 @@ fn run(cli: Cli) -> Result<()> {
             data,
             out,
             ..
-        } => {
-            use burn::config::Config;
-            let load = |p: PathBuf| -> Result<serde_json::Value> {
-                Ok(serde_json::from_str(
-                    &std::fs::read_to_string(&p)
-                        .with_context(|| format!("cannot read {}", p.display()))?,
-                )?)
-            };
-            let spam = serde_json::json!({
-                "vq": load(vq.join("config.json"))?["model"],
-                "base": load(base.join("config.json"))?["model"],
-                "residual": load(res.join("config.json"))?["model"],
-            });
-            std::fs::create_dir_all(&out)?;
-            // Parse it back so a wrong field fails here rather than in the page.
-            let text = serde_json::to_string_pretty(&spam)?;
-            std::fs::write(out.join("spam.json"), &text)?;
-            coma::model::SpamConfig::load(out.join("spam.json"))
-                .map_err(|e| anyhow::anyhow!("spam.json: {e}"))?;
-            for (from, to) in [
-                (vq.join("vq.bpk"), "vq.bpk"),
-                (base.join("base.bpk"), "base.bpk"),
-                (res.join("residual.bpk"), "residual.bpk"),
-                (data.join("Mean.npy"), "mean.npy"),
-                (data.join("Std.npy"), "std.npy"),
-            ] {
-                std::fs::copy(&from, out.join(to))
-                    .with_context(|| format!("copying {}", from.display()))?;
-            }
-            let device = burn::tensor::Device::flex();
-            coma::model::Spam::load(&out, &device)?;
-            println!("exported SPAM into {}", out.display());
-        }
+        } => export_spam(&vq, &base, res.as_deref(), &data, &out)?,
         Command::VqError {
             weights,
             config,
@@ -1262,7 +1358,6 @@ fn run(cli: Cli) -> Result<()> {
             layers,
         } => {
             use burn::config::Config;
-            use burn::module::Module;
             let split = match split.as_str() {
                 "train" => coma::dataset::Split::Train,
                 "val" => coma::dataset::Split::Val,
@@ -1272,11 +1367,7 @@ fn run(cli: Cli) -> Result<()> {
             let cfg = coma::train::vq::VqTrainingConfig::load(&config)
                 .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", config.display()))?;
             let device = burn::tensor::Device::flex();
-            let model = cfg
-                .model
-                .init(&device)
-                .try_load_file(&weights)
-                .map_err(|e| anyhow::anyhow!("cannot load {}: {e:?}", weights.display()))?;
+            let model = coma::weights::load_file(cfg.model.init(&device), &weights)?;
             let set = coma::train::motions::MotionSet::load(&data, split)?;
             let layers = layers.unwrap_or(cfg.model.layers);
             let e = coma::train::vq::reconstruction_errors(&model, &set, &device, limit, layers)?;
