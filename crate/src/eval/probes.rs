@@ -5,8 +5,8 @@
 //! - edit locality: editing one arm of a motion must leave the legs where they were;
 //! - continuity: the join of two blended segments must not be faster than real motion ever is.
 
-use crate::features::FPS;
-use crate::geom;
+use crate::features::{FeatureFrame, FPS, POSITIONS};
+use crate::geom::{self, Vec3};
 use crate::model::motion_model::sampling;
 use crate::model::MotionModel;
 use crate::skeleton::{joint, BodyPart, Pose};
@@ -84,7 +84,9 @@ pub struct LocalityReport {
 }
 
 /// Generates `base` (a walk), edits the left arm with `instruction`, and measures how much the
-/// legs moved (root-relative, so a changed path does not count) and what the arm did.
+/// legs moved and what the arm did. The legs are compared in the body's own frame (the
+/// features' joint positions: relative to the root, facing +Z), so a changed path or heading
+/// does not count as a leg change.
 pub fn edit_locality(
     model: &MotionModel,
     base: &str,
@@ -93,7 +95,6 @@ pub fn edit_locality(
 ) -> LocalityReport {
     let original = model.generate(base, &[], 120, seed);
     let edited = model.edit_parts(&original, instruction, &[BodyPart::LeftArm], base, seed + 1);
-    let (a, b) = (model.joints(&original), model.joints(&edited));
     let legs = [
         joint::L_HIP,
         joint::R_HIP,
@@ -104,16 +105,20 @@ pub fn edit_locality(
         joint::L_FOOT,
         joint::R_FOOT,
     ];
+    let local = |f: &FeatureFrame, j: usize| -> Vec3 {
+        let at = POSITIONS.start + (j - 1) * 3;
+        [f[at] as f64, f[at + 1] as f64, f[at + 2] as f64]
+    };
+    let (fa, fb) = (model.features(&original), model.features(&edited));
     let mut total = 0.0;
     let mut count = 0;
-    for (p, q) in a.iter().zip(&b) {
+    for (p, q) in fa.iter().zip(&fb) {
         for j in legs {
-            let rel_p = geom::sub(p[j], p[0]);
-            let rel_q = geom::sub(q[j], q[0]);
-            total += geom::dist(rel_p, rel_q);
+            total += geom::dist(local(p, j), local(q, j));
             count += 1;
         }
     }
+    let (a, b) = (model.joints(&original), model.joints(&edited));
     LocalityReport {
         leg_change_cm: total / count.max(1) as f64 * 100.0,
         left_wrist_rise_gain_cm: (wrist_rise(&b, joint::L_WRIST) - wrist_rise(&a, joint::L_WRIST))
