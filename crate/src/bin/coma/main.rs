@@ -272,27 +272,7 @@ enum DataCommand {
 #[derive(Subcommand)]
 enum TrainCommand {
     /// The VQ-VAE.
-    Vq {
-        /// Dataset folder (from `coma data build`).
-        #[arg(long, default_value = "data/bandai")]
-        data: PathBuf,
-        /// Run folder: checkpoints, logs, plots and the final weights.
-        #[arg(long, default_value = "runs/vq")]
-        run: PathBuf,
-        /// Training configuration (JSON); default: the run's own config.json when resuming,
-        /// otherwise configs/vq.json.
-        #[arg(long)]
-        config: Option<PathBuf>,
-        /// Stop (with a checkpoint) after this many minutes.
-        #[arg(long)]
-        minutes: Option<f64>,
-        /// Override the total number of steps.
-        #[arg(long)]
-        steps: Option<usize>,
-        /// Training backend: flex (pure Rust) or tch (libtorch; needs the `tch` feature).
-        #[arg(long, default_value = "flex")]
-        device: String,
-    },
+    Vq(RunArgs),
     /// The base transformer (layer-0 tokens from text).
     Base(TransformerArgs),
     /// Redraw a run's losses.png from its log.csv.
@@ -307,49 +287,26 @@ enum TrainCommand {
     Res(TransformerArgs),
     /// The text–motion evaluator (contrastive; measures motions, never generates).
     Evaluator {
-        /// Dataset folder (from `coma data build`).
-        #[arg(long, default_value = "data/bandai")]
-        data: PathBuf,
         /// Folder with the converted sentence encoder (minilm-*).
         #[arg(long, default_value = "static/models")]
         text_model: PathBuf,
-        #[arg(long, default_value = "runs/evaluator")]
-        run: PathBuf,
-        /// Training configuration (JSON); default: the run's config.json when resuming,
-        /// otherwise configs/evaluator.json.
-        #[arg(long)]
-        config: Option<PathBuf>,
-        /// Stop (with a checkpoint) after this many minutes.
-        #[arg(long)]
-        minutes: Option<f64>,
-        /// Override the total number of steps.
-        #[arg(long)]
-        steps: Option<usize>,
-        /// Training backend: flex (pure Rust) or tch (libtorch; needs the `tch` feature).
-        #[arg(long, default_value = "flex")]
-        device: String,
+        #[command(flatten)]
+        run: RunArgs,
     },
 }
 
+/// What every training command takes: the data, the run folder, the configuration and the
+/// limits of this invocation.
 #[derive(clap::Args)]
-struct TransformerArgs {
+struct RunArgs {
     /// Dataset folder (from `coma data build`).
     #[arg(long, default_value = "data/bandai")]
     data: PathBuf,
-    /// Trained VQ-VAE weights that tokenize the motions.
-    #[arg(long, default_value = "static/models/vq.bpk")]
-    vq: PathBuf,
-    /// The VQ-VAE's training configuration (for its sizes).
-    #[arg(long, default_value = "configs/vq.json")]
-    vq_config: PathBuf,
-    /// Folder with the converted sentence encoder (minilm-*).
-    #[arg(long, default_value = "static/models")]
-    text_model: PathBuf,
-    /// Run folder.
+    /// Run folder: checkpoints, logs, plots and the final weights (default: runs/<network>).
     #[arg(long)]
     run: Option<PathBuf>,
-    /// Training configuration (JSON); default: the run's config.json when resuming, else
-    /// configs/base.json or configs/res.json.
+    /// Training configuration (JSON); default: the run's own config.json when resuming,
+    /// otherwise configs/<network>.json.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Stop (with a checkpoint) after this many minutes.
@@ -361,6 +318,50 @@ struct TransformerArgs {
     /// Training backend: flex (pure Rust) or tch (libtorch; needs the `tch` feature).
     #[arg(long, default_value = "flex")]
     device: String,
+}
+
+impl RunArgs {
+    /// The run folder of network `name` and its configuration, with `--steps` applied by
+    /// `set_steps`.
+    fn open<C: burn::config::Config>(
+        &self,
+        name: &str,
+        set_steps: impl FnOnce(&mut C, usize),
+    ) -> Result<(PathBuf, C)> {
+        let run = self
+            .run
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("runs/{name}")));
+        let path = self.config.clone().unwrap_or_else(|| {
+            let own = run.join("config.json");
+            if own.exists() {
+                own
+            } else {
+                PathBuf::from(format!("configs/{name}.json"))
+            }
+        });
+        let mut config =
+            C::load(&path).map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
+        if let Some(s) = self.steps {
+            set_steps(&mut config, s);
+        }
+        Ok((run, config))
+    }
+}
+
+#[derive(clap::Args)]
+struct TransformerArgs {
+    #[command(flatten)]
+    run: RunArgs,
+    /// Trained VQ-VAE weights that tokenize the motions.
+    #[arg(long, default_value = "static/models/vq.bpk")]
+    vq: PathBuf,
+    /// The VQ-VAE's training configuration (for its sizes).
+    #[arg(long, default_value = "configs/vq.json")]
+    vq_config: PathBuf,
+    /// Folder with the converted sentence encoder (minilm-*).
+    #[arg(long, default_value = "static/models")]
+    text_model: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -555,22 +556,9 @@ fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs
     use burn::config::Config;
     use coma::train::transformer::{Kind, TransformerTrainOptions, TransformerTrainingConfig};
     let name = if kind == Kind::Base { "base" } else { "res" };
-    let run = args
+    let (run, cfg) = args
         .run
-        .unwrap_or_else(|| PathBuf::from(format!("runs/{name}")));
-    let path = args.config.unwrap_or_else(|| {
-        let own = run.join("config.json");
-        if own.exists() {
-            own
-        } else {
-            PathBuf::from(format!("configs/{name}.json"))
-        }
-    });
-    let mut cfg = TransformerTrainingConfig::load(&path)
-        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-    if let Some(s) = args.steps {
-        cfg.steps = s;
-    }
+        .open(name, |c: &mut TransformerTrainingConfig, s| c.steps = s)?;
     let plain = burn::tensor::Device::flex();
     let vq_cfg = coma::train::vq::VqTrainingConfig::load(&args.vq_config)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", args.vq_config.display()))?;
@@ -583,21 +571,22 @@ fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs
         coma::train::tokens::TokenSet::default()
     } else {
         let text = coma::text::minilm::SentenceEncoder::from_dir(&args.text_model, &plain)?;
-        let set = coma::train::motions::MotionSet::load(&args.data, coma::dataset::Split::Train)?;
+        let set =
+            coma::train::motions::MotionSet::load(&args.run.data, coma::dataset::Split::Train)?;
         coma::train::tokens::TokenSet::build(&set, &vq, &plain, &|t| Ok(text.encode(t)), &|l| {
             println!("{l}")
         })?
     };
     let options = TransformerTrainOptions {
         run_dir: run,
-        minutes: args.minutes,
+        minutes: args.run.minutes,
     };
     coma::train::transformer::train_transformer(
         kind,
         &cfg,
         &tokens,
         &options,
-        &coma::train::training_device(&args.device)?,
+        &coma::train::training_device(&args.run.device)?,
         &|l| println!("{l}"),
     )
 }
@@ -1020,36 +1009,15 @@ fn run(cli: Cli) -> Result<()> {
             println!("wrote {}", output.display());
         }
         Command::Train {
-            command:
-                TrainCommand::Vq {
-                    data,
-                    run,
-                    config,
-                    minutes,
-                    steps,
-                    device,
-                },
+            command: TrainCommand::Vq(args),
         } => {
-            use burn::config::Config;
             use coma::train::vq::{train_vq, VqTrainOptions, VqTrainingConfig};
-            let path = config.unwrap_or_else(|| {
-                let own = run.join("config.json");
-                if own.exists() {
-                    own
-                } else {
-                    PathBuf::from("configs/vq.json")
-                }
-            });
-            let mut cfg = VqTrainingConfig::load(&path)
-                .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-            if let Some(s) = steps {
-                cfg.steps = s;
-            }
-            let device = coma::train::training_device(&device)?;
+            let (run, cfg) = args.open("vq", |c: &mut VqTrainingConfig, s| c.steps = s)?;
+            let device = coma::train::training_device(&args.device)?;
             let options = VqTrainOptions {
-                data,
+                data: args.data,
                 run_dir: run,
-                minutes,
+                minutes: args.minutes,
             };
             train_vq(&cfg, &options, &device, &|line| println!("{line}"))?;
         }
@@ -1059,37 +1027,22 @@ fn run(cli: Cli) -> Result<()> {
         Command::Train {
             command:
                 TrainCommand::Evaluator {
-                    data,
                     text_model,
-                    run,
-                    config,
-                    minutes,
-                    steps,
-                    device,
+                    run: args,
                 },
         } => {
-            use burn::config::Config;
             use coma::train::evaluator::{
                 train_evaluator, CaptionedMotions, EvaluatorTrainOptions, EvaluatorTrainingConfig,
             };
-            let path = config.unwrap_or_else(|| {
-                let own = run.join("config.json");
-                if own.exists() {
-                    own
-                } else {
-                    PathBuf::from("configs/evaluator.json")
-                }
-            });
-            let mut cfg = EvaluatorTrainingConfig::load(&path)
-                .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-            if let Some(s) = steps {
-                cfg.steps = s;
-            }
+            let (run, cfg) = args.open("evaluator", |c: &mut EvaluatorTrainingConfig, s| {
+                c.steps = s
+            })?;
+            let data = &args.data;
             let plain = burn::tensor::Device::flex();
             let text = coma::text::minilm::SentenceEncoder::from_dir(&text_model, &plain)?;
             let embed = |t: &[&str]| Ok(text.encode(t));
             let load = |split| -> Result<CaptionedMotions> {
-                let set = coma::train::motions::MotionSet::load(&data, split)?;
+                let set = coma::train::motions::MotionSet::load(data, split)?;
                 CaptionedMotions::build(&set, &embed)
             };
             let train = load(coma::dataset::Split::Train)?;
@@ -1102,14 +1055,14 @@ fn run(cli: Cli) -> Result<()> {
             );
             let options = EvaluatorTrainOptions {
                 run_dir: run,
-                minutes,
+                minutes: args.minutes,
             };
             train_evaluator(
                 &cfg,
                 &train,
                 val.as_ref(),
                 &options,
-                &coma::train::training_device(&device)?,
+                &coma::train::training_device(&args.device)?,
                 &|l| println!("{l}"),
             )?;
         }
