@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Remakes the figures under docs/ from the default model in static/models: the filmstrips of
+# the model issue's four prompts and of the agents' acceptance prompt (built-in planner, no
+# LLM), each from a fixed seed so anyone gets the same pictures.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+coma=(cargo run --release -q -p coma --)
+out=docs/generated
+mkdir -p "$out"
+for prompt in "a person walks forward" "a person waves the left hand" \
+  "a person raises the right hand" "a person bows"; do
+  name="${prompt// /-}"
+  "${coma[@]}" generate "$prompt" --seconds 6 --seed 1 --png "$out/$name.png"
+done
+"${coma[@]}" run "A person walks forward waving the left hand, then turns right and bows" \
+  --seed 0 --png "$out/walk-wave-turn-bow.png" --json > "$out/walk-wave-turn-bow.json"
+echo "figures in $out"
