@@ -229,13 +229,16 @@ fn parse_parts(names: &[String]) -> Result<Vec<BodyPart>, String> {
         .collect()
 }
 
-/// Tokens from a link or the page must fit the model: 4 parts, its layer count, codes of its
-/// codebook and a length it can decode.
+/// Tokens from a link or the page must fit the model: 4 parts, the same number of layers in
+/// each (1 to the VQ-VAE's; a base-only model makes 1, and the decoder takes any prefix),
+/// codes of its codebook and a length it can decode.
 fn check_tokens(model: &MotionModel, tokens: &MotionTokens) -> Result<(), String> {
-    let layers = model.spam.vq_config.layers;
+    let most = model.spam.vq_config.layers;
+    let layers = tokens.first().map_or(0, Vec::len);
     let codes = model.spam.vq_config.codebook_size as u32;
     let steps = tokens.first().and_then(|p| p.first()).map_or(0, Vec::len);
     let fits = tokens.len() == 4
+        && (1..=most).contains(&layers)
         && steps > 0
         && steps <= coma::share::MAX_STEPS
         && tokens.iter().all(|p| {
@@ -247,7 +250,7 @@ fn check_tokens(model: &MotionModel, tokens: &MotionTokens) -> Result<(), String
         Ok(())
     } else {
         Err(format!(
-            "these tokens do not fit the loaded model (4 parts × {layers} layers of codes below {codes} expected)"
+            "these tokens do not fit the loaded model (4 parts × 1 to {most} layers of codes below {codes} expected)"
         ))
     }
 }
