@@ -94,13 +94,6 @@ pub fn run_bench(
     }
     let (_, t) = seconds_of(|| spam.decode(&tokens));
     rows.push(row("decode tokens to features", t * 1e3, "ms"));
-    let requests: Vec<_> = (0..16).map(|seed| (condition, 196, seed)).collect();
-    let (_, t) = seconds_of(|| spam.generate_batch(&requests, &options, requests.len()));
-    rows.push(row(
-        "tokens of 16 motions of 196 frames in one batch, per motion",
-        t * 1e3 / requests.len() as f64,
-        "ms",
-    ));
 
     let sizes = config.cloned().unwrap_or_else(|| {
         SpamConfig::new(spam.vq_config.clone(), spam.base_config.clone())

@@ -49,9 +49,6 @@ impl Default for ProtocolOptions {
     }
 }
 
-/// Motions SPAM decodes in one batch (only speed depends on it).
-const GENERATION_BATCH: usize = 32;
-
 /// R-precision batch size of the protocol.
 pub const BATCH: usize = 32;
 
@@ -220,40 +217,38 @@ impl Protocol<'_> {
                             .collect();
                     }
                     Source::Spam(spam) => {
-                        let length = |k: usize| self.test.items[order[k]].features.len().min(196);
-                        let one_each = sentences.iter().enumerate().map(|(k, s)| {
-                            (part_text(s, &[]), length(k), (repeat * 100_000 + k) as u64)
-                        });
-                        let samples = options.multimodality_samples;
-                        let several = sentences
+                        let generate = |sentence: &[f32; TEXT_DIM], frames: usize, seed: u64| {
+                            spam.decode(&spam.generate(
+                                &part_text(sentence, &[]),
+                                frames.min(196),
+                                &SamplingOptions {
+                                    seed,
+                                    ..Default::default()
+                                },
+                            ))
+                        };
+                        let length = |k: usize| self.test.items[order[k]].features.len();
+                        generated = sentences
+                            .iter()
+                            .enumerate()
+                            .map(|(k, s)| generate(s, length(k), (repeat * 100_000 + k) as u64))
+                            .collect();
+                        features = generated.iter().map(Vec::as_slice).collect();
+                        let groups: Vec<Vec<Vec<f32>>> = sentences
                             .iter()
                             .take(options.multimodality_texts)
                             .enumerate()
-                            .flat_map(|(k, s)| {
-                                (0..samples).map(move |j| {
-                                    let seed =
-                                        (1u64 << 40) + (repeat * 100_000 + k * 100 + j) as u64;
-                                    (part_text(s, &[]), length(k), seed)
-                                })
-                            });
-                        let requests: Vec<_> = one_each.chain(several).collect();
-                        let mut decoded: Vec<Vec<FeatureFrame>> = spam
-                            .generate_batch(
-                                &requests,
-                                &SamplingOptions::default(),
-                                GENERATION_BATCH,
-                            )
-                            .iter()
-                            .map(|t| spam.decode(t))
-                            .collect();
-                        let variants = decoded.split_off(sentences.len());
-                        generated = decoded;
-                        features = generated.iter().map(Vec::as_slice).collect();
-                        let groups: Vec<Vec<Vec<f32>>> = variants
-                            .chunks(samples.max(1))
-                            .map(|group| {
+                            .map(|(k, s)| {
+                                let samples: Vec<Vec<FeatureFrame>> = (0..options
+                                    .multimodality_samples)
+                                    .map(|j| {
+                                        let seed =
+                                            (1u64 << 40) + (repeat * 100_000 + k * 100 + j) as u64;
+                                        generate(s, length(k), seed)
+                                    })
+                                    .collect();
                                 let refs: Vec<&[FeatureFrame]> =
-                                    group.iter().map(Vec::as_slice).collect();
+                                    samples.iter().map(Vec::as_slice).collect();
                                 self.embed(&refs)
                             })
                             .collect();

@@ -82,38 +82,6 @@ impl Spam {
         self.fill(text, None, &vec![vec![true; n]; PARTS], options)
     }
 
-    /// New motions for `(text, frames, seed)` requests, each the same as [`Self::generate`]
-    /// with `options` and its seed would give, but decoded in batches of motions with the
-    /// same number of steps (one forward pass serves up to `batch` of them: much faster per
-    /// motion on a CPU).
-    pub fn generate_batch(
-        &self,
-        requests: &[(PartText, usize, u64)],
-        options: &SamplingOptions,
-        batch: usize,
-    ) -> Vec<MotionTokens> {
-        let steps = |frames: usize| steps_for_frames(frames, self.base_config.max_steps - 1);
-        let mut order: Vec<usize> = (0..requests.len()).collect();
-        order.sort_by_key(|&i| steps(requests[i].1));
-        let mut out: Vec<Option<MotionTokens>> = vec![None; requests.len()];
-        for group in order.chunk_by(|a, b| steps(requests[*a].1) == steps(requests[*b].1)) {
-            let n = steps(requests[group[0]].1);
-            for chunk in group.chunks(batch.max(1)) {
-                let texts: Vec<PartText> = chunk.iter().map(|&i| requests[i].0).collect();
-                let fixed = vec![vec![vec![None; n]; PARTS]; chunk.len()];
-                let mut rngs: Vec<Rng> = chunk.iter().map(|&i| Rng::new(requests[i].2)).collect();
-                let bases = self.decode_base_batch(&texts, &fixed, options, &mut rngs);
-                for (j, (base, rng)) in bases.into_iter().zip(&mut rngs).enumerate() {
-                    let tokens = self.decode_residual(&texts[j], base, None, options, rng);
-                    out[chunk[j]] = Some(tokens);
-                }
-            }
-        }
-        out.into_iter()
-            .map(|t| t.expect("every request decoded"))
-            .collect()
-    }
-
     /// Regenerates frames `from..to` of every part.
     pub fn inbetween(
         &self,
@@ -249,31 +217,6 @@ mod tests {
 
     fn spam() -> Spam {
         Spam::random(&tiny_vq(), &small(), Some(&small()), &Device::flex())
-    }
-
-    #[test]
-    fn a_batch_generates_what_one_at_a_time_does() {
-        let s = spam();
-        let text = |x: f32| [[x; TEXT_DIM]; PARTS];
-        let requests = [
-            (text(0.05), 40, 1),
-            (text(-0.2), 120, 2),
-            (text(0.3), 40, 3),
-            (text(0.05), 40, 4),
-        ];
-        let options = SamplingOptions::default();
-        let batched = s.generate_batch(&requests, &options, 2);
-        for ((t, frames, seed), got) in requests.iter().zip(&batched) {
-            let one = s.generate(
-                t,
-                *frames,
-                &SamplingOptions {
-                    seed: *seed,
-                    ..options.clone()
-                },
-            );
-            assert_eq!(got, &one, "seed {seed}");
-        }
     }
 
     #[test]

@@ -95,38 +95,33 @@ fn sample(logits: &[f32], options: &SamplingOptions, rng: &mut Rng) -> (u32, f32
     (last as u32, p[last])
 }
 
-/// Guided logits `[B, 4, N, K]` on the CPU: `(1 + s)·cond − s·uncond`, from a batch of
-/// `2B` (the conditional halves first).
+/// Guided logits `[4, N, K]` on the CPU: `(1 + s)·cond − s·uncond`, from a batch of two
+/// (conditional first).
 fn guided(logits: Tensor<4>, scale: f32) -> Vec<f32> {
-    let [b2, p, n, k] = logits.dims();
+    let [_, p, n, k] = logits.dims();
     let v: Vec<f32> = logits.try_into_vec_as::<f32>().expect("float logits");
-    let (cond, uncond) = v.split_at(b2 / 2 * p * n * k);
+    let (cond, uncond) = v.split_at(p * n * k);
     cond.iter()
         .zip(uncond)
         .map(|(c, u)| (1.0 + scale) * c - scale * u)
         .collect()
 }
 
-/// Inputs shared by every call for `B` texts: text `[2B, 4, 384]` (the texts twice) with
-/// keep `[2B, 4]` = 1 for the first `B` and 0 for the second (unconditional) half, and no
-/// padding.
+/// Inputs shared by every call: text `[2, 4, 384]` (same text twice) with keep `[2, 4]`
+/// = (1, 0), and no padding.
 fn conditions(
-    texts: &[[[f32; TEXT_DIM]; PARTS]],
+    text: &[[f32; TEXT_DIM]; PARTS],
     n: usize,
     device: &Device,
 ) -> (Tensor<3>, Tensor<2>, Tensor<2, Bool>) {
-    let b = texts.len();
-    let flat: Vec<f32> = texts.iter().flatten().flatten().copied().collect();
-    let once = Tensor::<3>::from_data(TensorData::new(flat, [b, PARTS, TEXT_DIM]), device);
-    let text = Tensor::cat(vec![once.clone(), once], 0);
+    let flat: Vec<f32> = text.iter().flatten().copied().collect();
+    let one = Tensor::<3>::from_data(TensorData::new(flat, [1, PARTS, TEXT_DIM]), device);
+    let text = Tensor::cat(vec![one.clone(), one], 0);
     let keep = Tensor::<2>::from_data(
-        TensorData::new(
-            [vec![1.0f32; b * PARTS], vec![0.0; b * PARTS]].concat(),
-            [2 * b, PARTS],
-        ),
+        TensorData::new([[1.0f32; PARTS], [0.0; PARTS]].concat(), [2, PARTS]),
         device,
     );
-    let pad = Tensor::<2, Int>::zeros([2 * b, n], device).equal_elem(1);
+    let pad = Tensor::<2, Int>::zeros([2, n], device).equal_elem(1);
     (text, keep, pad)
 }
 
@@ -140,99 +135,47 @@ impl Spam {
         options: &SamplingOptions,
         rng: &mut Rng,
     ) -> Vec<Vec<u32>> {
-        let mut out = self.decode_base_batch(
-            std::slice::from_ref(text),
-            std::slice::from_ref(&fixed.to_vec()),
-            options,
-            std::slice::from_mut(rng),
-        );
-        out.remove(0)
-    }
-
-    /// [`Self::decode_base`] for several motions of the same number of steps at once, each
-    /// with its own text, fixed tokens and random stream (faster per motion on a CPU: one
-    /// forward pass serves them all).
-    pub fn decode_base_batch(
-        &self,
-        texts: &[[[f32; TEXT_DIM]; PARTS]],
-        fixed: &[Vec<Vec<Option<u32>>>],
-        options: &SamplingOptions,
-        rngs: &mut [Rng],
-    ) -> Vec<Vec<Vec<u32>>> {
         let (model, config, device) = (&self.base, &self.base_config, &self.device);
-        let b = texts.len();
-        assert!(
-            fixed.len() == b && rngs.len() == b,
-            "one text, fixed set and rng per motion"
-        );
-        let n = fixed[0][0].len();
+        let n = fixed[0].len();
         let k = config.codebook_size;
         let mask = config.mask_id() as u32;
-        let (text_t, keep, pad) = conditions(texts, n, device);
-        // Per motion: its ids `[part][step]` flattened, and the positions it may change.
-        let mut ids: Vec<Vec<u32>> = fixed
+        let (text_t, keep, pad) = conditions(text, n, device);
+        let mut ids: Vec<u32> = fixed
             .iter()
-            .map(|f| {
-                f.iter()
-                    .flat_map(|p| p.iter().map(|t| t.unwrap_or(mask)))
-                    .collect()
-            })
+            .flat_map(|p| p.iter().map(|t| t.unwrap_or(mask)))
             .collect();
-        let free: Vec<Vec<usize>> = ids
-            .iter()
-            .map(|m| (0..m.len()).filter(|i| m[*i] == mask).collect())
-            .collect();
-        let mut confidence: Vec<Vec<f32>> = ids
-            .iter()
-            .zip(&free)
-            .map(|(m, f)| {
-                let mut c = vec![f32::INFINITY; m.len()];
-                f.iter().for_each(|i| c[*i] = f32::NEG_INFINITY);
-                c
-            })
-            .collect();
+        let free: Vec<usize> = (0..ids.len()).filter(|i| ids[*i] == mask).collect();
+        let mut confidence = vec![f32::INFINITY; ids.len()];
+        for i in &free {
+            confidence[*i] = f32::NEG_INFINITY;
+        }
         let iterations = options.iterations.max(1);
         for it in 0..iterations {
-            let ratio = mask_schedule(it as f64 / iterations as f64);
-            let mut remasked = Vec::with_capacity(b);
-            for m in 0..b {
-                // Re-mask the least confident free positions, as many as the schedule says.
-                let still = ((ratio * free[m].len() as f64).round() as usize)
-                    .max(1)
-                    .min(free[m].len());
-                let mut order = free[m].clone();
-                order.sort_by(|x, y| confidence[m][*x].total_cmp(&confidence[m][*y]));
-                order.truncate(still);
-                for i in &order {
-                    ids[m][*i] = mask;
+            // Re-mask the least confident free positions, as many as the schedule says.
+            let still =
+                (mask_schedule(it as f64 / iterations as f64) * free.len() as f64).round() as usize;
+            let still = still.max(1).min(free.len());
+            let mut order = free.clone();
+            order.sort_by(|a, b| confidence[*a].total_cmp(&confidence[*b]));
+            for (rank, i) in order.iter().enumerate() {
+                if rank < still {
+                    ids[*i] = mask;
                 }
-                remasked.push(order);
             }
-            let batch: Vec<i32> = ids
-                .iter()
-                .chain(ids.iter())
-                .flatten()
-                .map(|t| *t as i32)
-                .collect();
-            let tokens =
-                Tensor::<3, Int>::from_data(TensorData::new(batch, [2 * b, PARTS, n]), device);
+            let remasked: Vec<usize> = order.into_iter().take(still).collect();
+            let batch: Vec<i32> = ids.iter().chain(ids.iter()).map(|t| *t as i32).collect();
+            let tokens = Tensor::<3, Int>::from_data(TensorData::new(batch, [2, PARTS, n]), device);
             let logits = guided(
                 model.forward(tokens, text_t.clone(), keep.clone(), pad.clone()),
                 options.base_guidance,
             );
-            let per_motion = PARTS * n * k;
-            for (m, order) in remasked.into_iter().enumerate() {
-                let motion = &logits[m * per_motion..(m + 1) * per_motion];
-                for i in order {
-                    let (code, p) = sample(&motion[i * k..(i + 1) * k], options, &mut rngs[m]);
-                    ids[m][i] = code;
-                    confidence[m][i] = p;
-                }
+            for i in remasked {
+                let (code, p) = sample(&logits[i * k..(i + 1) * k], options, rng);
+                ids[i] = code;
+                confidence[i] = p;
             }
         }
-        ids.iter()
-            .map(|m| m.chunks(n).map(|c| c.to_vec()).collect())
-            .collect()
+        ids.chunks(n).map(|c| c.to_vec()).collect()
     }
 
     /// Predicts residual layers `1..layers` from layer 0 (`[part][step]`); positions that `keep`
@@ -257,7 +200,7 @@ impl Spam {
         let device = &self.device;
         let n = layers[0][0].len();
         let k = config.codebook_size;
-        let (text_t, keep_text, pad) = conditions(std::slice::from_ref(text), n, device);
+        let (text_t, keep_text, pad) = conditions(text, n, device);
         for j in 1..config.vq_layers {
             let mut flat = Vec::with_capacity(2 * PARTS * j * n);
             for _ in 0..2 {
