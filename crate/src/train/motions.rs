@@ -7,7 +7,7 @@ use crate::npy::NpyArray;
 use crate::rng::Rng;
 use crate::skeleton::BodyPart;
 use anyhow::{bail, Context, Result};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 /// One motion of the split.
@@ -21,6 +21,9 @@ pub struct MotionItem {
     pub captions: Vec<String>,
     /// Per-part sentences, where the dataset has them.
     pub parts: BTreeMap<BodyPart, String>,
+    /// The action it shows ("bow", "walk-turn-left"), where `dataset.json` names it:
+    /// training can balance rare actions against frequent ones by it.
+    pub content: Option<String>,
 }
 
 /// A loaded split.
@@ -29,6 +32,25 @@ pub struct MotionSet {
     pub items: Vec<MotionItem>,
     /// The dataset's Mean/Std (of its training split).
     pub normalizer: Normalizer,
+}
+
+/// Item name → content label, from `<dir>/dataset.json` (our builder writes one; a dataset
+/// in the plain HumanML3D layout has none, and its items go unlabelled).
+fn content_labels(dir: &Path) -> HashMap<String, String> {
+    #[derive(serde::Deserialize)]
+    struct Summary {
+        items: Vec<Labelled>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Labelled {
+        name: String,
+        content: String,
+    }
+    std::fs::read(dir.join("dataset.json"))
+        .ok()
+        .and_then(|bytes| serde_json::from_slice::<Summary>(&bytes).ok())
+        .map(|s| s.items.into_iter().map(|i| (i.name, i.content)).collect())
+        .unwrap_or_default()
 }
 
 /// A batch of equal-length crops, flattened as `batch × frames × 263` (normalised).
@@ -48,6 +70,7 @@ impl MotionSet {
             .with_context(|| format!("{} has no usable Mean.npy/Std.npy", dir.display()))?;
         let list = std::fs::read_to_string(dir.join(split.file_name()))
             .with_context(|| format!("cannot read {}", dir.join(split.file_name()).display()))?;
+        let contents = content_labels(dir);
         let mut items = Vec::new();
         for name in list.lines().map(str::trim).filter(|l| !l.is_empty()) {
             let path = dir.join("new_joint_vecs").join(format!("{name}.npy"));
@@ -76,6 +99,7 @@ impl MotionSet {
                 features: normalizer.normalize(&raw),
                 captions,
                 parts,
+                content: contents.get(name).cloned(),
             });
         }
         if items.is_empty() {

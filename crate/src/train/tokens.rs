@@ -23,6 +23,8 @@ pub struct TokenItem {
     pub captions: Vec<usize>,
     /// Index of each part's sentence in [`TokenSet::texts`], where the dataset has one.
     pub parts: [Option<usize>; PARTS],
+    /// The action it shows, where the dataset names it.
+    pub content: Option<String>,
 }
 
 /// Token items plus the embeddings of every text they use.
@@ -78,6 +80,7 @@ impl TokenSet {
                 tokens,
                 captions,
                 parts,
+                content: item.content.clone(),
             });
             if (i + 1) % 500 == 0 {
                 progress(&format!("tokenized {}/{} motions", i + 1, set.items.len()));
@@ -96,8 +99,23 @@ impl TokenSet {
         })
     }
 
+    /// How often each item is drawn, relative to the others: `n^-balance` for an item whose
+    /// action has `n` items (unlabelled items count as one action). 0 draws every item
+    /// equally often; 1 draws every action equally often, however rare.
+    pub fn draw_weights(&self, balance: f64) -> Vec<f64> {
+        let mut counts: HashMap<Option<&str>, usize> = HashMap::new();
+        for item in &self.items {
+            *counts.entry(item.content.as_deref()).or_default() += 1;
+        }
+        self.items
+            .iter()
+            .map(|i| (counts[&i.content.as_deref()] as f64).powf(-balance))
+            .collect()
+    }
+
     /// A random batch of `batch` motions of similar length (between ¾ of and the length of
-    /// a randomly drawn one). Each part's condition is the motion's own sentence
+    /// a randomly drawn one), drawn in proportion to `weights` (see [`Self::draw_weights`];
+    /// `None` draws uniformly). Each part's condition is the motion's own sentence
     /// for that part with probability `part_text`, else one of its global captions (the same
     /// for all parts that use it); the whole text is dropped with probability `drop_text`.
     pub fn batch(
@@ -107,23 +125,37 @@ impl TokenSet {
         batch: usize,
         part_text: f32,
         drop_text: f32,
+        weights: Option<&[f64]>,
         device: &Device,
     ) -> TokenBatch {
+        let total: f64 = weights.map_or(0.0, |w| w.iter().sum());
+        let draw = |rng: &mut Rng| match weights {
+            None => rng.below(self.items.len()),
+            Some(w) => {
+                let mut x = rng.uniform() as f64 * total;
+                w.iter()
+                    .position(|wi| {
+                        x -= wi;
+                        x < 0.0
+                    })
+                    .unwrap_or(w.len() - 1)
+            }
+        };
         // Motions of similar length go together, so little of the batch is padding.
-        let anchor = self.items[rng.below(self.items.len())].tokens[0][0].len();
+        let anchor = self.items[draw(rng)].tokens[0][0].len();
         let similar = |len: usize| len <= anchor && len * 4 >= anchor * 3;
         let mut picks: Vec<&TokenItem> = Vec::with_capacity(batch);
         for _ in 0..batch * 50 {
             if picks.len() == batch {
                 break;
             }
-            let item = &self.items[rng.below(self.items.len())];
+            let item = &self.items[draw(rng)];
             if similar(item.tokens[0][0].len()) {
                 picks.push(item);
             }
         }
         while picks.len() < batch {
-            picks.push(&self.items[rng.below(self.items.len())]);
+            picks.push(&self.items[draw(rng)]);
         }
         let lengths: Vec<usize> = picks.iter().map(|i| i.tokens[0][0].len()).collect();
         let n = lengths.iter().copied().max().unwrap_or(1);

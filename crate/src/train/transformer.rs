@@ -48,6 +48,12 @@ pub struct TransformerTrainingConfig {
     pub log_every: usize,
     #[config(default = 4321)]
     pub seed: u64,
+    /// How strongly rare actions are drawn more often (see `TokenSet::draw_weights`: 0 draws
+    /// every motion equally often, 1 every action), from step `balance_from` on.
+    #[config(default = 0.0)]
+    pub balance: f64,
+    #[config(default = 0)]
+    pub balance_from: usize,
 }
 
 /// Inputs and targets of one step.
@@ -202,6 +208,7 @@ pub fn train_transformer(
         progress(&run.resumed_line());
     }
     let epoch_steps = (data.items.len() as f64 / config.batch_size as f64).max(1.0);
+    let weights = (config.balance != 0.0).then(|| data.draw_weights(config.balance));
     while run.state.step < config.steps {
         let step = run.state.step;
         let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
@@ -211,6 +218,7 @@ pub fn train_transformer(
             config.batch_size,
             config.part_text as f32,
             config.drop_text as f32,
+            weights.as_deref().filter(|_| step >= config.balance_from),
             device,
         );
         let inputs = match kind {
@@ -293,6 +301,8 @@ mod tests {
                         .collect(),
                     captions: vec![i % 3],
                     parts: [Some(3), None, None, Some(4)],
+                    // Nine walks and three bows.
+                    content: Some(if i % 4 == 0 { "bow" } else { "walk" }.to_string()),
                 }
             })
             .collect();
@@ -322,12 +332,61 @@ mod tests {
     }
 
     #[test]
+    fn balancing_draws_rare_actions_as_often_as_frequent_ones() {
+        let set = tiny_set();
+        assert_eq!(set.draw_weights(0.0), vec![1.0; 12]);
+        let full = set.draw_weights(1.0);
+        let share = |w: &[f64], content: &str| {
+            let of: f64 = set
+                .items
+                .iter()
+                .zip(w)
+                .filter(|(i, _)| i.content.as_deref() == Some(content))
+                .map(|(_, w)| w)
+                .sum();
+            of / w.iter().sum::<f64>()
+        };
+        assert!((share(&full, "bow") - 0.5).abs() < 1e-12);
+        let half = set.draw_weights(0.5);
+        let bows = share(&half, "bow");
+        assert!(
+            bows > 0.25 && bows < 0.5,
+            "between uniform and balanced: {bows}"
+        );
+        // Drawn batches follow the weights: every item a bow when only bows weigh.
+        let only_bows: Vec<f64> = set
+            .items
+            .iter()
+            .map(|i| (i.content.as_deref() == Some("bow")) as u8 as f64)
+            .collect();
+        let mut rng = Rng::new(2);
+        let device = Device::flex();
+        for _ in 0..5 {
+            let batch = set.batch(
+                &config().model,
+                &mut rng,
+                4,
+                0.0,
+                0.0,
+                Some(&only_bows),
+                &device,
+            );
+            for len in &batch.lengths {
+                assert!(
+                    [3, 6, 7].contains(len),
+                    "bows are items 0, 4, 8: lengths 3, 7, 6"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn batches_pad_similar_lengths_and_masking_targets_only_masked_tokens() {
         let set = tiny_set();
         let cfg = config();
         let device = Device::flex();
         let mut rng = Rng::new(1);
-        let batch = set.batch(&cfg.model, &mut rng, 4, 0.3, 0.1, &device);
+        let batch = set.batch(&cfg.model, &mut rng, 4, 0.3, 0.1, None, &device);
         let (b, layers, n) = batch.dims;
         assert_eq!((b, layers), (4, 3));
         assert_eq!(n, *batch.lengths.iter().max().unwrap());
