@@ -4,7 +4,8 @@
 # LLM), each from a fixed seed so anyone gets the same pictures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-coma=(cargo run --release -q -p coma --)
+# COMA names an already built binary; by default cargo builds and runs it.
+if [ -n "${COMA:-}" ]; then coma=("$COMA"); else coma=(cargo run --release -q -p coma --); fi
 out=docs/generated
 mkdir -p "$out"
 for prompt in "a person walks forward" "a person waves the left hand" \
