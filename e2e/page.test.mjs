@@ -1,7 +1,9 @@
 // End-to-end test of the page in headless Chromium: load, generate with no LLM (the built-in
 // planner and the whole pipeline), watch the canvas move, share the link and rebuild the same
 // motion from it in a fresh page, download a BVH that our own reader parses, plan and run a
-// three-segment prompt whose link rebuilds it too, and take the screenshots under docs/.
+// three-segment prompt whose link rebuilds it too, and take the screenshots under docs/. A second
+// test runs SPAM on the browser's WebGPU (here SwiftShader, a software adapter, which the page
+// uses only when asked with ?backend=webgpu).
 //
 // Needs: the built page in DIST (default ../dist), the coma binary in COMA (serves the page and
 // reads the BVH), /usr/bin/chromium.
@@ -80,6 +82,7 @@ test("the page generates, plays, shares, rebuilds and exports a motion", { timeo
     console.log(`first load: ${(first.stats.bytes / 1e6).toFixed(2)} MB transferred`);
     const modelLine = await page.locator("#model-line").textContent();
     console.log(`backend: ${modelLine}`);
+    assert.match(await page.locator("#status").textContent(), /loaded .* on (WebGPU|the CPU)/);
 
     await page.fill("#prompt", "a person walks forward");
     await page.fill("#seconds", "9.8");
@@ -196,6 +199,51 @@ test("the page generates, plays, shares, rebuilds and exports a motion", { timeo
     }
 
     for (const p of [first, second, third, fourth]) {
+      assert.deepEqual(p.problems, [], "errors in the browser console");
+    }
+  } finally {
+    await browser.close();
+    server.kill();
+  }
+});
+
+test("SPAM runs on the browser's WebGPU when the page is asked to", { timeout: 30 * 60_000 }, async () => {
+  const server = spawn(COMA, ["serve", DIST, "--port", String(PORT)], { stdio: "inherit" });
+  const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
+  try {
+    await waitForServer();
+    const run = async (query, seconds) => {
+      const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+      const opened = await open(context, BASE + query);
+      await modelLoaded(opened.page);
+      const status = await opened.page.locator("#status").textContent();
+      await opened.page.fill("#prompt", "a person walks forward");
+      await opened.page.fill("#seconds", String(seconds));
+      await opened.page.locator("#seconds").dispatchEvent("change");
+      await opened.page.selectOption("#rounds", "0");
+      const started = Date.now();
+      await opened.page.click("#generate");
+      await opened.page.waitForFunction(() => Number(document.querySelector(".viewer")?.dataset.frames) > 0
+        && !document.querySelector("#generate").disabled, null, { timeout: LOAD_TIMEOUT });
+      const millis = Date.now() - started;
+      const frames = Number(await opened.page.locator(".viewer").getAttribute("data-frames"));
+      await opened.page.click("#share");
+      const link = await opened.page.locator("#share-link").inputValue();
+      return { ...opened, status, millis, frames, link };
+    };
+    // 2 s: SwiftShader runs the transformer far slower than the CPU backend does.
+    const gpu = await run("?backend=webgpu", 2);
+    console.log(`WebGPU page: ${gpu.status}`);
+    assert.match(gpu.status, /on WebGPU/, "the page did not run SPAM on WebGPU");
+    console.log(`generated ${gpu.frames} frames on WebGPU (SwiftShader) in ${(gpu.millis / 1000).toFixed(1)} s in the page`);
+    assert.ok(Math.abs(gpu.frames - 40) <= 4, `asked 40 frames, got ${gpu.frames}`);
+    const cpu = await run("?backend=cpu", 2);
+    assert.match(cpu.status, /on the CPU \(the page asked for the CPU backend/);
+    // The same prompt and seed on both backends: floating-point sums in another order may
+    // flip a close draw, so say whether the tokens agree rather than require it.
+    const tokens = (link) => link.split("#")[1];
+    console.log(`the same on the CPU backend: ${(cpu.millis / 1000).toFixed(1)} s; same tokens as WebGPU: ${tokens(cpu.link) === tokens(gpu.link)}`);
+    for (const p of [gpu, cpu]) {
       assert.deepEqual(p.problems, [], "errors in the browser console");
     }
   } finally {

@@ -30,7 +30,8 @@ build_page() {
   local target_dir="${CARGO_TARGET_DIR:-target}"
   cargo build --release -p coma-web --target wasm32-unknown-unknown
   rm -rf dist && mkdir -p dist/pkg
-  wasm-bindgen --target web --no-typescript --out-dir dist/pkg \
+  # Without the name section: function names for stack traces, megabytes users would download.
+  wasm-bindgen --target web --no-typescript --remove-name-section --out-dir dist/pkg \
     "$target_dir/wasm32-unknown-unknown/release/coma_web.wasm"
   cp index.html dist/
   cp -r static dist/static

@@ -3,6 +3,7 @@
 //! second each network trains at, on this machine's CPU. With a configuration of another size
 //! (such as the paper's), the same measurement runs on random weights.
 
+use crate::executor::block_on;
 use crate::features::FEATURE_DIM;
 use crate::model::generate::SamplingOptions;
 use crate::model::transformer::{PARTS, TEXT_DIM};
@@ -81,18 +82,19 @@ pub fn run_bench(
     let mut rng = Rng::new(0);
     let n = 49;
     let fixed = vec![vec![None; n]; PARTS];
-    let (base, t) = seconds_of(|| spam.decode_base(&condition, &fixed, &options, &mut rng));
+    let (base, t) =
+        seconds_of(|| block_on(spam.decode_base(&condition, &fixed, &options, &mut rng)));
     rows.push(row(
         "base tokens, 196 frames (10 iterations)",
         t * 1e3,
         "ms",
     ));
     let (tokens, t) =
-        seconds_of(|| spam.decode_residual(&condition, base, None, &options, &mut rng));
+        seconds_of(|| block_on(spam.decode_residual(&condition, base, None, &options, &mut rng)));
     if spam.residual.is_some() {
         rows.push(row("residual tokens, 196 frames", t * 1e3, "ms"));
     }
-    let (_, t) = seconds_of(|| spam.decode(&tokens));
+    let (_, t) = seconds_of(|| block_on(spam.decode(&tokens)));
     rows.push(row("decode tokens to features", t * 1e3, "ms"));
 
     let sizes = config.cloned().unwrap_or_else(|| {

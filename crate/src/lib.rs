@@ -4,10 +4,12 @@
 //! +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
 
 pub mod agents;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod bench;
 pub mod bvh;
 pub mod dataset;
 pub mod eval;
+pub mod executor;
 pub mod features;
 pub mod geom;
 pub mod model;

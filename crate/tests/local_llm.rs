@@ -5,11 +5,12 @@
 //! go through, replies come back, and JSON modes give JSON.
 
 use coma::agents::llm::{
-    block_on, parse_json_content, ChatOptions, ChatReply, LlmClient, LlmConfig, Message,
-    ReplyFormat, UreqTransport,
+    parse_json_content, ChatOptions, ChatReply, LlmClient, LlmConfig, Message, ReplyFormat,
+    UreqTransport,
 };
 use coma::agents::planner::llm::plan;
 use coma::dataset::Vocabulary;
+use coma::executor::block_on;
 use serde_json::{json, Value};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};

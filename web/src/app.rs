@@ -140,6 +140,11 @@ fn on_reply(state: AppState, reply: Reply) {
                 c.as_ref().map(|c| {
                     c.send(&Request::Load {
                         base: crate::browser::absolute_url("static/models/"),
+                        backend: crate::browser::query("backend").and_then(|b| match b.as_str() {
+                            "cpu" => Some(Backend::Cpu),
+                            "webgpu" => Some(Backend::WebGpu),
+                            _ => None,
+                        }),
                     })
                 })
             });
@@ -158,9 +163,14 @@ fn on_reply(state: AppState, reply: Reply) {
         } => {
             state.progress.set(None);
             state.say(format!(
-                "Model {model_id} loaded ({:.1} MB in {:.1} s){}. Type a prompt and press Generate.",
+                "Model {model_id} loaded ({:.1} MB in {:.1} s) on {}{}. Type a prompt and press Generate.",
                 bytes as f64 / 1e6,
                 millis / 1000.0,
+                match (backend, &note) {
+                    (Backend::WebGpu, _) => "WebGPU".to_string(),
+                    (Backend::Cpu, Some(why)) => format!("the CPU ({why})"),
+                    (Backend::Cpu, None) => "the CPU".to_string(),
+                },
                 if missing.is_empty() {
                     String::new()
                 } else {

@@ -40,6 +40,17 @@ pub async fn copy_text(text: &str) -> Result<(), String> {
         .map_err(|e| format!("the browser refused the clipboard: {e:?}"))
 }
 
+/// The value of `name` in the page's query string (`?backend=cpu`), if it is there.
+pub fn query(name: &str) -> Option<String> {
+    let search = window().ok()?.location().search().ok()?;
+    search
+        .trim_start_matches('?')
+        .split('&')
+        .filter_map(|pair| pair.split_once('='))
+        .find(|(key, _)| *key == name)
+        .map(|(_, value)| value.to_string())
+}
+
 /// The URL fragment without its `#`.
 pub fn fragment() -> String {
     window()

@@ -12,8 +12,14 @@ pub type PartName = String;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Request {
-    /// Fetch the models under `base` (a URL folder such as `static/models/`) and load them.
-    Load { base: String },
+    /// Fetch the models under `base` (a URL folder such as `static/models/`) and load them,
+    /// on `backend` when one is asked for (the page's `?backend=` query), else on the best
+    /// one the browser has.
+    Load {
+        base: String,
+        #[serde(default)]
+        backend: Option<Backend>,
+    },
     /// The whole CoMA loop: plan `prompt` (with the LLM in `llm`, else the built-in planner),
     /// then generate, edit, review for up to `rounds` rounds and blend. `plan` (a plan's JSON,
     /// e.g. a link's) skips planning; `seconds` stretches or shrinks the plan to that length.

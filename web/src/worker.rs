@@ -95,7 +95,63 @@ async fn fetch(url: &str) -> Result<Vec<u8>, String> {
         .map_err(|e| format!("cannot download {url}: {e}"))
 }
 
-async fn load(base: &str) -> Result<Reply, String> {
+/// Whether the browser offers a WebGPU adapter: `None` without one, else whether it is a
+/// software (fallback) adapter such as SwiftShader.
+async fn webgpu_adapter() -> Option<bool> {
+    let navigator = js_sys::Reflect::get(&scope(), &"navigator".into()).ok()?;
+    let gpu = js_sys::Reflect::get(&navigator, &"gpu".into()).ok()?;
+    let request = js_sys::Reflect::get(&gpu, &"requestAdapter".into())
+        .ok()?
+        .dyn_into::<js_sys::Function>()
+        .ok()?;
+    let promise = request
+        .call0(&gpu)
+        .ok()?
+        .dyn_into::<js_sys::Promise>()
+        .ok()?;
+    let adapter = wasm_bindgen_futures::JsFuture::from(promise).await.ok()?;
+    if adapter.is_null() || adapter.is_undefined() {
+        return None;
+    }
+    // Newer browsers say it in `adapter.info`, older ones on the adapter itself.
+    let flag = |of: &JsValue| {
+        js_sys::Reflect::get(of, &"isFallbackAdapter".into())
+            .ok()
+            .and_then(|v| v.as_bool())
+    };
+    let info = js_sys::Reflect::get(&adapter, &"info".into()).ok();
+    Some(
+        info.as_ref()
+            .and_then(flag)
+            .or_else(|| flag(&adapter))
+            .unwrap_or(false),
+    )
+}
+
+/// The device SPAM runs on: WebGPU where the browser has a hardware adapter (or where it is
+/// asked for), else the CPU backend, with the reason.
+async fn choose_device(asked: Option<Backend>) -> (burn::tensor::Device, Backend, Option<String>) {
+    let cpu = |why: String| (burn::tensor::Device::flex(), Backend::Cpu, Some(why));
+    if asked == Some(Backend::Cpu) {
+        return cpu("the page asked for the CPU backend (?backend=cpu)".into());
+    }
+    match webgpu_adapter().await {
+        None => cpu("this browser offers no WebGPU adapter, so the model runs on the CPU".into()),
+        Some(true) if asked != Some(Backend::WebGpu) => cpu(
+            "the browser's only WebGPU adapter is a software one, slower than the CPU backend, \
+             so the model runs on the CPU (?backend=webgpu uses it anyway)"
+                .into(),
+        ),
+        Some(_) => match burn::tensor::Device::wgpu_options().init_async().await {
+            Ok(device) => (device, Backend::WebGpu, None),
+            Err(e) => cpu(format!(
+                "WebGPU did not start ({e}), so the model runs on the CPU"
+            )),
+        },
+    }
+}
+
+async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
     let started = now();
     let base = base.trim_end_matches('/');
     let not_here = |e: String| {
@@ -151,9 +207,10 @@ async fn load(base: &str) -> Result<Reply, String> {
     };
     let config = std::str::from_utf8(&config_bytes)
         .map_err(|_| "spam.json is not UTF-8 text".to_string())?;
-    // The models run on the CPU backend: generation reads logits back synchronously, which
-    // WebGPU in a browser cannot do.
-    let device = burn::tensor::Device::flex();
+    let (device, backend, note) = choose_device(asked).await;
+    // The sentence encoder and the evaluator stay on the CPU: they answer synchronous calls
+    // of the planner and the reviewer, and are quick there.
+    let cpu = burn::tensor::Device::flex();
     let model = MotionModel::from_files(
         &SpamFiles {
             config,
@@ -169,6 +226,7 @@ async fn load(base: &str) -> Result<Reply, String> {
             model: file(MODEL_FILE),
         },
         &device,
+        &cpu,
     )
     .map_err(|e| format!("the model does not load: {e}"))?;
     let mut missing = Vec::new();
@@ -176,7 +234,7 @@ async fn load(base: &str) -> Result<Reply, String> {
         [Ok(config), Ok(weights)] => std::str::from_utf8(&config)
             .map_err(|_| "evaluator.json is not UTF-8 text".to_string())
             .and_then(|config| {
-                Evaluator::from_bytes(config, &weights, &device).map_err(|e| e.to_string())
+                Evaluator::from_bytes(config, &weights, &cpu).map_err(|e| e.to_string())
             }),
         [config, weights] => Err(config.err().or(weights.err()).unwrap_or_default()),
     };
@@ -210,8 +268,8 @@ async fn load(base: &str) -> Result<Reply, String> {
     });
     Ok(Reply::Loaded {
         model_id,
-        backend: Backend::Cpu,
-        note: Some("the model runs on the CPU backend in this version".into()),
+        backend,
+        note,
         bytes,
         millis: now() - started,
         missing,
@@ -257,11 +315,15 @@ fn check_tokens(model: &MotionModel, tokens: &MotionTokens) -> Result<(), String
 
 /// The motion of `tokens`, with the paths of `plan` (JSON) laid on its root where it reads
 /// as a plan; the notes say which paths could not be laid.
-fn motion(model: &MotionModel, tokens: MotionTokens, plan: Option<&str>) -> (Motion, Vec<String>) {
+async fn motion(
+    model: &MotionModel,
+    tokens: MotionTokens,
+    plan: Option<&str>,
+) -> (Motion, Vec<String>) {
     let plan = plan.and_then(|p| planning::parse_plan(p).ok());
     let (features, notes) = match &plan {
-        Some(plan) => pipeline::motion_features(model, plan, &tokens),
-        None => (model.features(&tokens), Vec::new()),
+        Some(plan) => pipeline::motion_features(model, plan, &tokens).await,
+        None => (model.features(&tokens).await, Vec::new()),
     };
     let joints = coma::features::features_to_joints(&features)
         .iter()
@@ -283,7 +345,7 @@ fn models() -> Result<Rc<Models>, String> {
 
 async fn answer(request: Request) -> Result<Reply, String> {
     match request {
-        Request::Load { base } => load(&base).await,
+        Request::Load { base, backend } => load(&base, backend).await,
         Request::Run {
             prompt,
             seed,
@@ -297,7 +359,7 @@ async fn answer(request: Request) -> Result<Reply, String> {
         }
         other => {
             let models = models()?;
-            edit(&models.model, other)
+            edit(&models.model, other).await
         }
     }
 }
@@ -397,7 +459,8 @@ async fn run(
         model,
         run.tokens.clone(),
         serde_json::to_string(&run.plan).ok().as_deref(),
-    );
+    )
+    .await;
     let scores: Vec<SegmentScores> = planning::scores(&run);
     notes.extend(run.plan.notes.iter().cloned());
     notes.extend(run.notes.iter().cloned());
@@ -413,7 +476,7 @@ async fn run(
 }
 
 /// The requests that make or change tokens without the agents.
-fn edit(model: &MotionModel, request: Request) -> Result<Reply, String> {
+async fn edit(model: &MotionModel, request: Request) -> Result<Reply, String> {
     let started = now();
     let (tokens, plan) = match request {
         Request::Load { .. } | Request::Run { .. } => {
@@ -433,7 +496,9 @@ fn edit(model: &MotionModel, request: Request) -> Result<Reply, String> {
                 return Err("type what the person should do first".into());
             }
             (
-                model.generate(&prompt, &parts, frames_for_seconds(seconds), seed),
+                model
+                    .generate(&prompt, &parts, frames_for_seconds(seconds), seed)
+                    .await,
                 None,
             )
         }
@@ -454,7 +519,9 @@ fn edit(model: &MotionModel, request: Request) -> Result<Reply, String> {
                 ));
             }
             (
-                model.inbetween(&tokens, &text, from, to.min(frames), seed),
+                model
+                    .inbetween(&tokens, &text, from, to.min(frames), seed)
+                    .await,
                 plan,
             )
         }
@@ -470,15 +537,18 @@ fn edit(model: &MotionModel, request: Request) -> Result<Reply, String> {
             if parts.is_empty() {
                 return Err("choose at least one body part to edit".into());
             }
-            let rest = coma::posecodes::describe_motion(&model.joints(&tokens));
-            (model.edit_parts(&tokens, &text, &parts, &rest, seed), plan)
+            let rest = coma::posecodes::describe_motion(&model.joints(&tokens).await);
+            (
+                model.edit_parts(&tokens, &text, &parts, &rest, seed).await,
+                plan,
+            )
         }
         Request::Decode { tokens, plan } => {
             check_tokens(model, &tokens)?;
             (tokens, plan)
         }
     };
-    let (motion, notes) = motion(model, tokens, plan.as_deref());
+    let (motion, notes) = motion(model, tokens, plan.as_deref()).await;
     Ok(Reply::Motion {
         motion,
         millis: now() - started,

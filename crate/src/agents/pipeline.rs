@@ -157,7 +157,7 @@ pub async fn run<T: Transport>(
     for (index, segment) in plan.segments.iter().enumerate() {
         let frames = frames_for_seconds(segment.seconds);
         let seed = seed_of(options.seed, index, 0);
-        let mut tokens = model.generate(&segment.base, &[], frames, seed);
+        let mut tokens = model.generate(&segment.base, &[], frames, seed).await;
         let frames = tokens[0][0].len() * DOWNSAMPLE;
         let range = (start_frame, start_frame + frames as u32);
         history.push(Edit {
@@ -171,7 +171,9 @@ pub async fn run<T: Transport>(
         progress(RunEvent::Generated { index, segment });
         for (k, (text, parts)) in grouped_edits(segment).into_iter().enumerate() {
             let seed = seed_of(options.seed, index, 1 + k as u64);
-            tokens = model.edit_parts(&tokens, &text, &parts, &segment.base, seed);
+            tokens = model
+                .edit_parts(&tokens, &text, &parts, &segment.base, seed)
+                .await;
             history.push(Edit {
                 kind: EditKind::BodyParts,
                 text: text.clone(),
@@ -186,14 +188,11 @@ pub async fn run<T: Transport>(
                 text: &text,
             });
         }
-        let score = |tokens: &MotionTokens| {
-            scorer.map(|s| s.segment_score(segment, &model.spam.decode(tokens)))
-        };
-        let score_before = score(&tokens);
+        let score_before = segment_score(model, scorer, segment, &tokens).await;
         let mut current = score_before;
         let mut rounds = Vec::new();
         for round in 0..options.rounds {
-            let normalized = model.spam.decode(&tokens);
+            let normalized = model.spam.decode(&tokens).await;
             let poses = features_to_joints(&model.normalizer.denormalize(&normalized));
             let mut review = match scorer {
                 Some(s) => reviewer::judge_offline(segment, &poses, &normalized, s),
@@ -235,13 +234,15 @@ pub async fn run<T: Transport>(
             let mut edits = Vec::new();
             for (k, c) in review.corrections.iter().enumerate() {
                 let seed = seed_of(options.seed, index, 100 + 10 * round as u64 + k as u64);
-                candidate = model.edit_parts(
-                    &candidate,
-                    &c.instruction,
-                    c.region.parts(),
-                    &segment.base,
-                    seed,
-                );
+                candidate = model
+                    .edit_parts(
+                        &candidate,
+                        &c.instruction,
+                        c.region.parts(),
+                        &segment.base,
+                        seed,
+                    )
+                    .await;
                 edits.push(Edit {
                     kind: EditKind::BodyParts,
                     text: c.instruction.clone(),
@@ -251,7 +252,7 @@ pub async fn run<T: Transport>(
                     seed,
                 });
             }
-            let after = score(&candidate);
+            let after = segment_score(model, scorer, segment, &candidate).await;
             let accepted = match (current, after) {
                 (Some(before), Some(after)) => after >= before,
                 _ => true,
@@ -282,7 +283,7 @@ pub async fn run<T: Transport>(
         });
         start_frame = range.1;
     }
-    let tokens = blend(model, &plan, &segments, options.seed, &mut history);
+    let tokens = blend(model, &plan, &segments, options.seed, &mut history).await;
     if plan.segments.len() > 1 {
         progress(RunEvent::Blended);
     }
@@ -296,12 +297,26 @@ pub async fn run<T: Transport>(
     }
 }
 
+/// The evaluator's 0–100 similarity of `segment`'s text with `tokens`' motion, where there is
+/// an evaluator.
+async fn segment_score(
+    model: &MotionModel,
+    scorer: Option<&Scorer<'_>>,
+    segment: &Segment,
+    tokens: &MotionTokens,
+) -> Option<f64> {
+    match scorer {
+        Some(s) => Some(s.segment_score(segment, &model.spam.decode(tokens).await)),
+        None => None,
+    }
+}
+
 /// The condition a segment's motion was made with, for the transition into or out of it.
 fn condition(model: &MotionModel, segment: &Segment) -> PartText {
     model.condition(&segment.base, &segment.parts.edits())
 }
 
-fn blend(
+async fn blend(
     model: &MotionModel,
     plan: &Plan,
     segments: &[SegmentRun],
@@ -314,14 +329,17 @@ fn blend(
         let seed = seed_of(seed, i, 900);
         let a = condition(model, &plan.segments[i - 1]);
         let b = condition(model, &plan.segments[i]);
-        joined = model.spam.blend(
-            &joined,
-            &next.tokens,
-            &a,
-            &b,
-            BLEND_OVERLAP_STEPS,
-            &sampling(seed),
-        );
+        joined = model
+            .spam
+            .blend(
+                &joined,
+                &next.tokens,
+                &a,
+                &b,
+                BLEND_OVERLAP_STEPS,
+                &sampling(seed),
+            )
+            .await;
         let overlap = (BLEND_OVERLAP_STEPS * DOWNSAMPLE) as u32;
         history.push(Edit {
             kind: EditKind::Blend,
@@ -354,12 +372,12 @@ pub fn segment_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range
 
 /// The features (not normalised, 20 fps) of a run's tokens with every segment's path laid on
 /// the root. A link rebuilds the motion with this and its plan alone.
-pub fn motion_features(
+pub async fn motion_features(
     model: &MotionModel,
     plan: &Plan,
     tokens: &MotionTokens,
 ) -> (Features, Vec<String>) {
-    let mut features = model.features(tokens);
+    let mut features = model.features(tokens).await;
     let mut notes = Vec::new();
     for (segment, range) in plan.segments.iter().zip(segment_ranges(plan, tokens)) {
         if let Some(path) = &segment.trajectory {
@@ -376,8 +394,8 @@ pub fn motion_features(
 }
 
 /// Joint positions (metres, 20 fps) of a run.
-pub fn motion_joints(model: &MotionModel, plan: &Plan, tokens: &MotionTokens) -> Vec<Pose> {
-    features_to_joints(&motion_features(model, plan, tokens).0)
+pub async fn motion_joints(model: &MotionModel, plan: &Plan, tokens: &MotionTokens) -> Vec<Pose> {
+    features_to_joints(&motion_features(model, plan, tokens).await.0)
 }
 
 /// How well a segment walked the path it asked for.

@@ -302,8 +302,9 @@ pub async fn describe_with_vision<T: Transport>(
 mod tests {
     use super::*;
     use crate::agents::llm::script_server::{ScriptServer, ScriptedReply};
-    use crate::agents::llm::{block_on, LlmConfig};
+    use crate::agents::llm::LlmConfig;
     use crate::agents::plan::PartEdits;
+    use crate::executor::block_on;
 
     fn segment() -> Segment {
         Segment {

@@ -75,7 +75,7 @@ pub fn review_figures(
     let (mut before, mut after, mut improved, mut kept) = (Vec::new(), Vec::new(), 0, 0);
     for (i, p) in prompts.iter().enumerate() {
         let plan = offline::plan(&p.prompt, Some(&embed));
-        let run = crate::agents::llm::block_on(pipeline::run(
+        let run = crate::executor::block_on(pipeline::run(
             model,
             Some(scorer),
             None::<&LlmClient<UreqTransport>>,
@@ -111,7 +111,7 @@ pub fn review_figures(
 /// Plans and generates "a person walks in a circle clockwise" and measures the root path.
 pub fn circle_probe(model: &MotionModel, seed: u64) -> Option<CircleReport> {
     let plan = offline::plan("a person walks in a circle clockwise", None);
-    let run = crate::agents::llm::block_on(pipeline::run(
+    let run = crate::executor::block_on(pipeline::run(
         model,
         None,
         None::<&LlmClient<UreqTransport>>,
@@ -119,7 +119,8 @@ pub fn circle_probe(model: &MotionModel, seed: u64) -> Option<CircleReport> {
         RunOptions { rounds: 0, seed },
         &mut |_| {},
     ));
-    let (features, notes) = pipeline::motion_features(model, &run.plan, &run.tokens);
+    let (features, notes) =
+        crate::executor::block_on(pipeline::motion_features(model, &run.plan, &run.tokens));
     notes
         .is_empty()
         .then(|| circle_report(&root_path(&features), true))

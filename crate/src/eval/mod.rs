@@ -6,6 +6,10 @@
 pub mod agents;
 pub mod evaluator;
 pub mod metrics;
+// Measurements run natively, blocking on the model's reads.
+#[cfg(not(target_arch = "wasm32"))]
 pub mod probes;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod protocol;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod report;

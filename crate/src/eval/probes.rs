@@ -5,6 +5,7 @@
 //! - edit locality: editing one arm of a motion must leave the legs where they were;
 //! - continuity: the join of two blended segments must not be faster than real motion ever is.
 
+use crate::executor::block_on;
 use crate::features::{FeatureFrame, FPS, POSITIONS};
 use crate::geom::{self, Vec3};
 use crate::model::motion_model::sampling;
@@ -60,7 +61,11 @@ pub fn left_right(model: &MotionModel, seeds: u64, seconds: f64) -> LeftRightRep
     for (prompt, asked, other) in prompts {
         let correct = (0..seeds)
             .filter(|seed| {
-                let poses = model.joints(&model.generate(prompt, &[], frames, *seed));
+                let poses = block_on(async {
+                    model
+                        .joints(&model.generate(prompt, &[], frames, *seed).await)
+                        .await
+                });
                 wrist_rise(&poses, asked) > wrist_rise(&poses, other)
             })
             .count();
@@ -93,8 +98,9 @@ pub fn edit_locality(
     instruction: &str,
     seed: u64,
 ) -> LocalityReport {
-    let original = model.generate(base, &[], 120, seed);
-    let edited = model.edit_parts(&original, instruction, &[BodyPart::LeftArm], base, seed + 1);
+    let original = block_on(model.generate(base, &[], 120, seed));
+    let edited =
+        block_on(model.edit_parts(&original, instruction, &[BodyPart::LeftArm], base, seed + 1));
     let legs = [
         joint::L_HIP,
         joint::R_HIP,
@@ -109,7 +115,10 @@ pub fn edit_locality(
         let at = POSITIONS.start + (j - 1) * 3;
         [f[at] as f64, f[at + 1] as f64, f[at + 2] as f64]
     };
-    let (fa, fb) = (model.features(&original), model.features(&edited));
+    let (fa, fb) = (
+        block_on(model.features(&original)),
+        block_on(model.features(&edited)),
+    );
     let mut total = 0.0;
     let mut count = 0;
     for (p, q) in fa.iter().zip(&fb) {
@@ -118,7 +127,10 @@ pub fn edit_locality(
             count += 1;
         }
     }
-    let (a, b) = (model.joints(&original), model.joints(&edited));
+    let (a, b) = (
+        block_on(model.joints(&original)),
+        block_on(model.joints(&edited)),
+    );
     LocalityReport {
         leg_change_cm: total / count.max(1) as f64 * 100.0,
         left_wrist_rise_gain_cm: (wrist_rise(&b, joint::L_WRIST) - wrist_rise(&a, joint::L_WRIST))
@@ -208,10 +220,10 @@ pub fn continuity(
     seed: u64,
 ) -> ContinuityReport {
     let (ta, tb) = (model.condition(first, &[]), model.condition(second, &[]));
-    let a = model.generate(first, &[], 100, seed);
-    let b = model.generate(second, &[], 100, seed + 1);
-    let joined = model.spam.blend(&a, &b, &ta, &tb, 2, &sampling(seed + 2));
-    let poses = model.joints(&joined);
+    let a = block_on(model.generate(first, &[], 100, seed));
+    let b = block_on(model.generate(second, &[], 100, seed + 1));
+    let joined = block_on(model.spam.blend(&a, &b, &ta, &tb, 2, &sampling(seed + 2)));
+    let poses = block_on(model.joints(&joined));
     let join = a[0][0].len() * crate::model::vq::DOWNSAMPLE;
     let speeds = frame_speeds(&poses);
     let near = &speeds[join.saturating_sub(2).min(speeds.len())..(join + 2).min(speeds.len())];

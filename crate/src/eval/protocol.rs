@@ -6,6 +6,7 @@
 use super::evaluator::{Evaluator, EvaluatorConfig};
 use super::metrics::{diversity, fid, mm_dist, multimodality, r_precision, Interval};
 use super::probes::foot_skating;
+use crate::executor::block_on;
 use crate::features::{features_to_joints, FeatureFrame};
 use crate::model::edit::part_text;
 use crate::model::generate::SamplingOptions;
@@ -218,14 +219,15 @@ impl Protocol<'_> {
                     }
                     Source::Spam(spam) => {
                         let generate = |sentence: &[f32; TEXT_DIM], frames: usize, seed: u64| {
-                            spam.decode(&spam.generate(
-                                &part_text(sentence, &[]),
-                                frames.min(196),
-                                &SamplingOptions {
+                            block_on(async {
+                                let options = SamplingOptions {
                                     seed,
                                     ..Default::default()
-                                },
-                            ))
+                                };
+                                let text = part_text(sentence, &[]);
+                                let tokens = spam.generate(&text, frames.min(196), &options).await;
+                                spam.decode(&tokens).await
+                            })
                         };
                         let length = |k: usize| self.test.items[order[k]].features.len();
                         generated = sentences

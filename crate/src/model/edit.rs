@@ -42,7 +42,7 @@ pub fn steps_for_frames(frames: usize, max_steps: usize) -> usize {
 
 impl Spam {
     /// Fills the masked base positions, then the residual layers, keeping what is fixed.
-    fn fill(
+    async fn fill(
         &self,
         text: &PartText,
         original: Option<&MotionTokens>,
@@ -66,13 +66,14 @@ impl Spam {
                     .collect()
             })
             .collect();
-        let base = self.decode_base(text, &fixed, options, &mut rng);
+        let base = self.decode_base(text, &fixed, options, &mut rng).await;
         let keep = original.map(|tokens| KeepResidual { tokens, editable });
         self.decode_residual(text, base, keep, options, &mut rng)
+            .await
     }
 
     /// A new motion of about `frames` frames (a multiple of 4, at most the model's maximum).
-    pub fn generate(
+    pub async fn generate(
         &self,
         text: &PartText,
         frames: usize,
@@ -80,10 +81,11 @@ impl Spam {
     ) -> MotionTokens {
         let n = steps_for_frames(frames, self.base_config.max_steps - 1);
         self.fill(text, None, &vec![vec![true; n]; PARTS], options)
+            .await
     }
 
     /// Regenerates frames `from..to` of every part.
-    pub fn inbetween(
+    pub async fn inbetween(
         &self,
         tokens: &MotionTokens,
         text: &PartText,
@@ -96,11 +98,11 @@ impl Spam {
         let editable: Vec<Vec<bool>> = (0..PARTS)
             .map(|_| (0..n).map(|s| s >= a && s < b).collect())
             .collect();
-        self.fill(text, Some(tokens), &editable, options)
+        self.fill(text, Some(tokens), &editable, options).await
     }
 
     /// Regenerates the chosen parts from their new text (other parts keep their text).
-    pub fn edit_parts(
+    pub async fn edit_parts(
         &self,
         tokens: &MotionTokens,
         text: &PartText,
@@ -118,12 +120,12 @@ impl Spam {
                     .collect()
             })
             .collect();
-        self.fill(text, Some(tokens), &editable, options)
+        self.fill(text, Some(tokens), &editable, options).await
     }
 
     /// Joins `a` then `b`: the last `overlap` steps of `a` and the first `overlap` of `b` are
     /// regenerated as a transition, conditioned on both sides (text: the mean of the two).
-    pub fn blend(
+    pub async fn blend(
         &self,
         a: &MotionTokens,
         b: &MotionTokens,
@@ -164,7 +166,7 @@ impl Spam {
             v.iter_mut().for_each(|x| *x /= norm);
             v
         });
-        let window = self.fill(&text, Some(&joined), &editable, options);
+        let window = self.fill(&text, Some(&joined), &editable, options).await;
         (0..PARTS)
             .map(|p| {
                 (0..layers)
@@ -185,7 +187,7 @@ impl Spam {
     }
 
     /// Normalised features of tokens (`4 × steps` frames).
-    pub fn decode(&self, tokens: &MotionTokens) -> Vec<FeatureFrame> {
+    pub async fn decode(&self, tokens: &MotionTokens) -> Vec<FeatureFrame> {
         let n = tokens[0][0].len();
         let parts = tokens
             .iter()
@@ -199,11 +201,7 @@ impl Spam {
                     .collect()
             })
             .collect();
-        let out: Vec<f32> = self
-            .vq
-            .decode(&parts)
-            .try_into_vec_as::<f32>()
-            .expect("float features");
+        let out = super::read_floats(self.vq.decode(&parts)).await;
         out.chunks_exact(FEATURE_DIM)
             .map(|c| c.try_into().expect("263 columns"))
             .collect()
@@ -213,7 +211,15 @@ impl Spam {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::executor::block_on;
     use crate::model::generate::tests::{small, tiny_vq};
+
+    fn seeded(seed: u64) -> SamplingOptions {
+        SamplingOptions {
+            seed,
+            ..Default::default()
+        }
+    }
 
     fn spam() -> Spam {
         Spam::random(&tiny_vq(), &small(), Some(&small()), &Device::flex())
@@ -221,105 +227,74 @@ mod tests {
 
     #[test]
     fn generated_length_follows_the_request() {
-        let s = spam();
-        let text = [[0.05f32; TEXT_DIM]; PARTS];
-        for frames in [40, 42, 120] {
-            let tokens = s.generate(&text, frames, &SamplingOptions::default());
-            let got = s.decode(&tokens).len();
-            assert!(
-                (got as i64 - frames as i64).abs() <= 4,
-                "asked {frames}, got {got}"
-            );
-        }
+        block_on(async {
+            let s = spam();
+            let text = [[0.05f32; TEXT_DIM]; PARTS];
+            for frames in [40, 42, 120] {
+                let tokens = s.generate(&text, frames, &SamplingOptions::default()).await;
+                let got = s.decode(&tokens).await.len();
+                assert!(
+                    (got as i64 - frames as i64).abs() <= 4,
+                    "asked {frames}, got {got}"
+                );
+            }
+        })
     }
 
     #[test]
     fn inbetween_keeps_everything_outside_the_range() {
-        let s = spam();
-        let text = [[0.05f32; TEXT_DIM]; PARTS];
-        let original = s.generate(
-            &text,
-            48,
-            &SamplingOptions {
-                seed: 1,
-                ..Default::default()
-            },
-        );
-        let edited = s.inbetween(
-            &original,
-            &[[0.3f32; TEXT_DIM]; PARTS],
-            16,
-            32,
-            &SamplingOptions {
-                seed: 2,
-                ..Default::default()
-            },
-        );
-        for p in 0..PARTS {
-            for l in 0..original[p].len() {
-                assert_eq!(original[p][l][..4], edited[p][l][..4]);
-                assert_eq!(original[p][l][8..], edited[p][l][8..]);
+        block_on(async {
+            let s = spam();
+            let text = [[0.05f32; TEXT_DIM]; PARTS];
+            let original = s.generate(&text, 48, &seeded(1)).await;
+            let edited = s
+                .inbetween(&original, &[[0.3f32; TEXT_DIM]; PARTS], 16, 32, &seeded(2))
+                .await;
+            for p in 0..PARTS {
+                for l in 0..original[p].len() {
+                    assert_eq!(original[p][l][..4], edited[p][l][..4]);
+                    assert_eq!(original[p][l][8..], edited[p][l][8..]);
+                }
             }
-        }
+        })
     }
 
     #[test]
     fn part_edit_mostly_keeps_the_other_parts() {
-        let s = spam();
-        let text = [[0.05f32; TEXT_DIM]; PARTS];
-        let original = s.generate(
-            &text,
-            160,
-            &SamplingOptions {
-                seed: 1,
-                ..Default::default()
-            },
-        );
-        let edited = s.edit_parts(
-            &original,
-            &text,
-            &[BodyPart::LeftArm],
-            &SamplingOptions {
-                seed: 3,
-                ..Default::default()
-            },
-        );
-        let n = original[0][0].len();
-        let same = (0..n)
-            .filter(|&i| original[3][0][i] == edited[3][0][i])
-            .count();
-        assert!(
-            same as f32 >= 0.75 * n as f32,
-            "right leg kept {same} of {n} base tokens"
-        );
+        block_on(async {
+            let s = spam();
+            let text = [[0.05f32; TEXT_DIM]; PARTS];
+            let original = s.generate(&text, 160, &seeded(1)).await;
+            let edited = s
+                .edit_parts(&original, &text, &[BodyPart::LeftArm], &seeded(3))
+                .await;
+            let n = original[0][0].len();
+            let same = (0..n)
+                .filter(|&i| original[3][0][i] == edited[3][0][i])
+                .count();
+            assert!(
+                same as f32 >= 0.75 * n as f32,
+                "right leg kept {same} of {n} base tokens"
+            );
+        })
     }
 
     #[test]
     fn blend_joins_lengths() {
-        let s = spam();
-        let text = [[0.05f32; TEXT_DIM]; PARTS];
-        let a = s.generate(
-            &text,
-            64,
-            &SamplingOptions {
-                seed: 1,
-                ..Default::default()
-            },
-        );
-        let b = s.generate(
-            &text,
-            80,
-            &SamplingOptions {
-                seed: 2,
-                ..Default::default()
-            },
-        );
-        let joined = s.blend(&a, &b, &text, &text, 2, &SamplingOptions::default());
-        assert_eq!(joined[0][0].len(), 16 + 20);
-        assert_eq!(joined[1][0][..5], a[1][0][..5]);
-        assert_eq!(
-            joined[2][2][joined[2][2].len() - 5..],
-            b[2][2][b[2][2].len() - 5..]
-        );
+        block_on(async {
+            let s = spam();
+            let text = [[0.05f32; TEXT_DIM]; PARTS];
+            let a = s.generate(&text, 64, &seeded(1)).await;
+            let b = s.generate(&text, 80, &seeded(2)).await;
+            let joined = s
+                .blend(&a, &b, &text, &text, 2, &SamplingOptions::default())
+                .await;
+            assert_eq!(joined[0][0].len(), 16 + 20);
+            assert_eq!(joined[1][0][..5], a[1][0][..5]);
+            assert_eq!(
+                joined[2][2][joined[2][2].len() - 5..],
+                b[2][2][b[2][2].len() - 5..]
+            );
+        })
     }
 }

@@ -97,9 +97,9 @@ fn sample(logits: &[f32], options: &SamplingOptions, rng: &mut Rng) -> (u32, f32
 
 /// Guided logits `[4, N, K]` on the CPU: `(1 + s)·cond − s·uncond`, from a batch of two
 /// (conditional first).
-fn guided(logits: Tensor<4>, scale: f32) -> Vec<f32> {
+async fn guided(logits: Tensor<4>, scale: f32) -> Vec<f32> {
     let [_, p, n, k] = logits.dims();
-    let v: Vec<f32> = logits.try_into_vec_as::<f32>().expect("float logits");
+    let v = super::read_floats(logits).await;
     let (cond, uncond) = v.split_at(p * n * k);
     cond.iter()
         .zip(uncond)
@@ -128,7 +128,7 @@ fn conditions(
 impl Spam {
     /// Fills the masked layer-0 tokens by iterative unmasking. `fixed[p][n]` holds tokens that
     /// must stay (editing); `None` everywhere generates from scratch. Returns `[part][step]`.
-    pub fn decode_base(
+    pub async fn decode_base(
         &self,
         text: &[[f32; TEXT_DIM]; PARTS],
         fixed: &[Vec<Option<u32>>],
@@ -168,7 +168,8 @@ impl Spam {
             let logits = guided(
                 model.forward(tokens, text_t.clone(), keep.clone(), pad.clone()),
                 options.base_guidance,
-            );
+            )
+            .await;
             for i in remasked {
                 let (code, p) = sample(&logits[i * k..(i + 1) * k], options, rng);
                 ids[i] = code;
@@ -181,11 +182,11 @@ impl Spam {
     /// Predicts residual layers `1..layers` from layer 0 (`[part][step]`); positions that `keep`
     /// marks as not editable take the original tokens. Returns `[part][layer][step]`, with
     /// layer 0 alone for a base-only model.
-    pub fn decode_residual(
+    pub async fn decode_residual(
         &self,
         text: &[[f32; TEXT_DIM]; PARTS],
         base: Vec<Vec<u32>>,
-        keep: Option<KeepResidual>,
+        keep: Option<KeepResidual<'_>>,
         options: &SamplingOptions,
         rng: &mut Rng,
     ) -> MotionTokens {
@@ -215,7 +216,8 @@ impl Spam {
             let logits = guided(
                 model.forward(lower, j, text_t.clone(), keep_text.clone(), pad.clone()),
                 options.residual_guidance,
-            );
+            )
+            .await;
             for (p, part) in layers.iter_mut().enumerate() {
                 let row: Vec<u32> = (0..n)
                     .map(|s| {
@@ -244,6 +246,7 @@ pub struct KeepResidual<'a> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::executor::block_on;
 
     #[test]
     fn schedule_goes_from_all_to_none() {
@@ -306,8 +309,8 @@ pub(crate) mod tests {
                 ..Default::default()
             };
             let mut rng = Rng::new(seed);
-            let b = spam.decode_base(&text, &fixed, &options, &mut rng);
-            spam.decode_residual(&text, b, None, &options, &mut rng)
+            let b = block_on(spam.decode_base(&text, &fixed, &options, &mut rng));
+            block_on(spam.decode_residual(&text, b, None, &options, &mut rng))
         };
         let a = run(5);
         assert_eq!(a, run(5));
@@ -329,8 +332,8 @@ pub(crate) mod tests {
         let text = [[0.1f32; TEXT_DIM]; PARTS];
         let options = SamplingOptions::default();
         let mut rng = Rng::new(1);
-        let b = spam.decode_base(&text, &vec![vec![None; 6]; PARTS], &options, &mut rng);
-        let tokens = spam.decode_residual(&text, b.clone(), None, &options, &mut rng);
+        let b = block_on(spam.decode_base(&text, &vec![vec![None; 6]; PARTS], &options, &mut rng));
+        let tokens = block_on(spam.decode_residual(&text, b.clone(), None, &options, &mut rng));
         assert_eq!(tokens.len(), PARTS);
         for (part, base) in tokens.iter().zip(&b) {
             assert_eq!(part, &vec![base.clone()], "one layer, the base tokens");

@@ -14,6 +14,18 @@ use vq::{MotionVq, VqConfig};
 
 use burn::prelude::*;
 
+/// A float tensor's values on the host. Awaited, because a browser's WebGPU device can hand
+/// data back only asynchronously; on the CPU backends the future is ready at once.
+pub(crate) async fn read_floats<const D: usize>(tensor: Tensor<D>) -> Vec<f32> {
+    tensor
+        .into_data_async()
+        .await
+        .expect("the device returns what it computed")
+        .convert::<f32>()
+        .try_into_vec::<f32>()
+        .expect("floats converted to f32")
+}
+
 /// The networks of SPAM on one device, ready to generate.
 #[derive(Debug)]
 pub struct Spam {

@@ -43,14 +43,18 @@ pub struct MotionModel {
 
 impl MotionModel {
     /// A model from the contents of its files (no file system, so it works in the page).
+    /// SPAM runs on `device`, the sentence encoder on `text_device`: the page keeps the
+    /// encoder on the CPU, since the planner asks for embeddings in synchronous callbacks and
+    /// one sentence is quick there.
     pub fn from_files(
         spam: &SpamFiles,
         text: &TextFiles,
         device: &Device,
+        text_device: &Device,
     ) -> Result<MotionModel, MotionModelError> {
         let id = spam.id();
         let (spam, normalizer) = Spam::from_bytes(spam, device)?;
-        let text = SentenceEncoder::from_bytes(text.vocab, text.words, text.model, device)?;
+        let text = SentenceEncoder::from_bytes(text.vocab, text.words, text.model, text_device)?;
         Ok(MotionModel {
             spam,
             normalizer,
@@ -82,22 +86,24 @@ impl MotionModel {
     }
 
     /// A new motion of about `frames` frames (4 to [`MAX_FRAMES`], in steps of 4).
-    pub fn generate(
+    pub async fn generate(
         &self,
         prompt: &str,
         parts: &[(BodyPart, String)],
         frames: usize,
         seed: u64,
     ) -> MotionTokens {
-        self.spam.generate(
-            &self.condition(prompt, parts),
-            frames.clamp(4, MAX_FRAMES),
-            &sampling(seed),
-        )
+        self.spam
+            .generate(
+                &self.condition(prompt, parts),
+                frames.clamp(4, MAX_FRAMES),
+                &sampling(seed),
+            )
+            .await
     }
 
     /// Frames `from..to` (20 fps) of every part regenerated from `text`.
-    pub fn inbetween(
+    pub async fn inbetween(
         &self,
         tokens: &MotionTokens,
         text: &str,
@@ -105,18 +111,20 @@ impl MotionModel {
         to: usize,
         seed: u64,
     ) -> MotionTokens {
-        self.spam.inbetween(
-            tokens,
-            &self.condition(text, &[]),
-            from,
-            to,
-            &sampling(seed),
-        )
+        self.spam
+            .inbetween(
+                tokens,
+                &self.condition(text, &[]),
+                from,
+                to,
+                &sampling(seed),
+            )
+            .await
     }
 
     /// The `parts` regenerated from `instruction`; the other parts are conditioned on
     /// `rest`, what the whole motion does (its prompt, or a description of it).
-    pub fn edit_parts(
+    pub async fn edit_parts(
         &self,
         tokens: &MotionTokens,
         instruction: &str,
@@ -128,22 +136,24 @@ impl MotionModel {
             .iter()
             .map(|p| (*p, instruction.to_string()))
             .collect();
-        self.spam.edit_parts(
-            tokens,
-            &self.condition(rest, &overrides),
-            parts,
-            &sampling(seed),
-        )
+        self.spam
+            .edit_parts(
+                tokens,
+                &self.condition(rest, &overrides),
+                parts,
+                &sampling(seed),
+            )
+            .await
     }
 
     /// The features (not normalised) of tokens.
-    pub fn features(&self, tokens: &MotionTokens) -> Features {
-        self.normalizer.denormalize(&self.spam.decode(tokens))
+    pub async fn features(&self, tokens: &MotionTokens) -> Features {
+        self.normalizer.denormalize(&self.spam.decode(tokens).await)
     }
 
     /// Joint positions of tokens (metres, 20 fps).
-    pub fn joints(&self, tokens: &MotionTokens) -> Vec<Pose> {
-        features_to_joints(&self.features(tokens))
+    pub async fn joints(&self, tokens: &MotionTokens) -> Vec<Pose> {
+        features_to_joints(&self.features(tokens).await)
     }
 }
 

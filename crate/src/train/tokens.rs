@@ -35,6 +35,18 @@ pub struct TokenSet {
     pub embeddings: Vec<[f32; TEXT_DIM]>,
 }
 
+/// How a batch is drawn: its size, how its texts are chosen and how its motions are weighted.
+#[derive(Clone, Copy, Debug)]
+pub struct BatchDraw<'a> {
+    pub batch: usize,
+    /// Probability that a part is conditioned on its own sentence.
+    pub part_text: f32,
+    /// Probability that a motion's whole text is dropped (guidance training).
+    pub drop_text: f32,
+    /// Relative draw weight of every item (see [`TokenSet::draw_weights`]); `None` is uniform.
+    pub weights: Option<&'a [f64]>,
+}
+
 /// A batch for the transformers: inputs, targets and conditions.
 #[derive(Debug)]
 pub struct TokenBatch {
@@ -113,21 +125,24 @@ impl TokenSet {
             .collect()
     }
 
-    /// A random batch of `batch` motions of similar length (between ¾ of and the length of
-    /// a randomly drawn one), drawn in proportion to `weights` (see [`Self::draw_weights`];
-    /// `None` draws uniformly). Each part's condition is the motion's own sentence
-    /// for that part with probability `part_text`, else one of its global captions (the same
-    /// for all parts that use it); the whole text is dropped with probability `drop_text`.
+    /// A random batch of `draw.batch` motions of similar length (between ¾ of and the length
+    /// of a randomly drawn one), drawn in proportion to `draw.weights`. Each part's condition
+    /// is the motion's own sentence for that part with probability `draw.part_text`, else one
+    /// of its global captions (the same for all parts that use it); the whole text is dropped
+    /// with probability `draw.drop_text`.
     pub fn batch(
         &self,
         config: &TransformerConfig,
         rng: &mut Rng,
-        batch: usize,
-        part_text: f32,
-        drop_text: f32,
-        weights: Option<&[f64]>,
+        draw: &BatchDraw,
         device: &Device,
     ) -> TokenBatch {
+        let BatchDraw {
+            batch,
+            part_text,
+            drop_text,
+            weights,
+        } = *draw;
         let total: f64 = weights.map_or(0.0, |w| w.iter().sum());
         let draw = |rng: &mut Rng| match weights {
             None => rng.below(self.items.len()),

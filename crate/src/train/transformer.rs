@@ -3,7 +3,7 @@
 //! smoothing, text dropout for classifier-free guidance, resumable checkpoints.
 
 use super::run::Run;
-use super::tokens::{TokenBatch, TokenSet};
+use super::tokens::{BatchDraw, TokenBatch, TokenSet};
 use crate::model::generate::mask_schedule;
 use crate::model::transformer::{BaseTransformer, ResidualTransformer, TransformerConfig, PARTS};
 use crate::rng::Rng;
@@ -212,15 +212,13 @@ pub fn train_transformer(
     while run.state.step < config.steps {
         let step = run.state.step;
         let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        let batch = data.batch(
-            &config.model,
-            &mut rng,
-            config.batch_size,
-            config.part_text as f32,
-            config.drop_text as f32,
-            weights.as_deref().filter(|_| step >= config.balance_from),
-            device,
-        );
+        let draw = BatchDraw {
+            batch: config.batch_size,
+            part_text: config.part_text as f32,
+            drop_text: config.drop_text as f32,
+            weights: weights.as_deref().filter(|_| step >= config.balance_from),
+        };
+        let batch = data.batch(&config.model, &mut rng, &draw, device);
         let inputs = match kind {
             Kind::Base => base_step(&batch, &config.model, &mut rng, device),
             Kind::Residual => residual_step(&batch, &mut rng, device),
@@ -362,15 +360,13 @@ mod tests {
         let mut rng = Rng::new(2);
         let device = Device::flex();
         for _ in 0..5 {
-            let batch = set.batch(
-                &config().model,
-                &mut rng,
-                4,
-                0.0,
-                0.0,
-                Some(&only_bows),
-                &device,
-            );
+            let draw = BatchDraw {
+                batch: 4,
+                part_text: 0.0,
+                drop_text: 0.0,
+                weights: Some(&only_bows),
+            };
+            let batch = set.batch(&config().model, &mut rng, &draw, &device);
             for len in &batch.lengths {
                 assert!(
                     [3, 6, 7].contains(len),
@@ -386,7 +382,13 @@ mod tests {
         let cfg = config();
         let device = Device::flex();
         let mut rng = Rng::new(1);
-        let batch = set.batch(&cfg.model, &mut rng, 4, 0.3, 0.1, None, &device);
+        let draw = BatchDraw {
+            batch: 4,
+            part_text: 0.3,
+            drop_text: 0.1,
+            weights: None,
+        };
+        let batch = set.batch(&cfg.model, &mut rng, &draw, &device);
         let (b, layers, n) = batch.dims;
         assert_eq!((b, layers), (4, 3));
         assert_eq!(n, *batch.lengths.iter().max().unwrap());

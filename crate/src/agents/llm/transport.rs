@@ -75,7 +75,7 @@ pub enum TransportError {
 }
 
 /// Sends requests and waits. Natively both may block (the client's future is then driven by
-/// [`super::block_on`]); in the page they are real futures. No `Send` bound, since the page's
+/// [`crate::executor::block_on`]); in the page they are real futures. No `Send` bound, since the page's
 /// futures hold JS values.
 pub trait Transport {
     /// POSTs `request` and returns the server's reply, whatever its status.

@@ -1,7 +1,8 @@
 //! The native transport: blocking HTTP(S) with `ureq` and rustls.
 
-use super::{block_on, ChatOptions, ChatReply, LlmClient, LlmConfig, LlmError, Message};
+use super::{ChatOptions, ChatReply, LlmClient, LlmConfig, LlmError, Message};
 use super::{HttpReply, HttpRequest, ReplyFormat, Transport, TransportError};
+use crate::executor::block_on;
 use std::time::Duration;
 
 /// Blocking HTTP(S) through one `ureq` agent (so connections are pooled across requests).

@@ -2,12 +2,13 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use coma::agents::llm::{block_on, LlmClient, LlmConfig, UreqTransport};
+use coma::agents::llm::{LlmClient, LlmConfig, UreqTransport};
 use coma::agents::pipeline::{self, RunOptions};
 use coma::agents::plan::Plan;
 use coma::agents::planner;
 use coma::agents::reviewer::Scorer;
 use coma::dataset::Vocabulary;
+use coma::executor::block_on;
 use coma::model::MotionModel;
 use coma::trajectory::Trajectory;
 use std::path::{Path, PathBuf};
@@ -231,7 +232,8 @@ pub fn run(args: RunArgs) -> Result<()> {
             }
         },
     ));
-    let (features, path_notes) = pipeline::motion_features(&model, &run.plan, &run.tokens);
+    let (features, path_notes) =
+        block_on(pipeline::motion_features(&model, &run.plan, &run.tokens));
     let mut written = Vec::new();
     for out in &args.out {
         let motion = coma::motion_file::MotionData::Features(features.clone());

@@ -2,6 +2,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
+use coma::executor::block_on;
 use coma::motion_file::{read_motion, write_motion};
 use coma::render::{FilmstripOptions, View};
 use std::path::PathBuf;
@@ -738,7 +739,7 @@ fn export_spam(
             temperature: 0.0,
             ..Default::default()
         };
-        let [a, b] = [&full, &half].map(|spam| spam.generate(&condition, 196, &options));
+        let [a, b] = [&full, &half].map(|spam| block_on(spam.generate(&condition, 196, &options)));
         for (x, y) in a
             .iter()
             .flatten()
@@ -1084,9 +1085,9 @@ fn run(cli: Cli) -> Result<()> {
             let parts = parse_parts(&parts)?;
             let model = load_model(&model.models)?;
             let frames = coma::model::motion_model::frames_for_seconds(seconds);
-            let tokens = model.generate(&prompt, &parts, frames, seed);
+            let tokens = block_on(model.generate(&prompt, &parts, frames, seed));
             write_outputs(
-                &model.features(&tokens),
+                &block_on(model.features(&tokens)),
                 out.as_deref(),
                 png.as_deref(),
                 &prompt,
@@ -1115,13 +1116,13 @@ fn run(cli: Cli) -> Result<()> {
             let edited = match (from, to, parts.is_empty()) {
                 (Some(a), Some(b), true) => {
                     let fps = coma::features::FPS;
-                    model.inbetween(
+                    block_on(model.inbetween(
                         &tokens,
                         &instruction,
                         (a * fps) as usize,
                         (b * fps).ceil() as usize,
                         seed,
-                    )
+                    ))
                 }
                 (None, None, false) => {
                     let chosen = parts
@@ -1135,13 +1136,13 @@ fn run(cli: Cli) -> Result<()> {
                     let rest = coma::posecodes::describe_motion(
                         &coma::features::features_to_joints(&motion),
                     );
-                    model.edit_parts(&tokens, &instruction, &chosen, &rest, seed)
+                    block_on(model.edit_parts(&tokens, &instruction, &chosen, &rest, seed))
                 }
                 _ => bail!(
                     "give either --from and --to (in-between edit) or --parts (body-part edit)"
                 ),
             };
-            let features = model.features(&edited);
+            let features = block_on(model.features(&edited));
             write_outputs(&features, Some(&out), png.as_deref(), &instruction)?;
         }
         Command::Bench {

@@ -1,6 +1,7 @@
 use super::*;
 use crate::agents::llm::script_server::{ScriptServer, ScriptedReply};
-use crate::agents::llm::{block_on, Backoff, LlmConfig, UreqTransport};
+use crate::agents::llm::{Backoff, LlmConfig, UreqTransport};
+use crate::executor::block_on;
 use std::time::Duration;
 
 const PROMPT: &str = "A person walks forward waving the left hand, then turns right and bows";
