@@ -188,11 +188,16 @@ pub async fn run<T: Transport>(
                 text: &text,
             });
         }
-        let score_before = segment_score(model, scorer, segment, &tokens).await;
+        // The segment's features, decoded once per token set: scoring and reviewing read them.
+        let mut normalized = if scorer.is_some() || options.rounds > 0 {
+            model.spam.decode(&tokens).await
+        } else {
+            Vec::new()
+        };
+        let score_before = scorer.map(|s| s.segment_score(segment, &normalized));
         let mut current = score_before;
         let mut rounds = Vec::new();
         for round in 0..options.rounds {
-            let normalized = model.spam.decode(&tokens).await;
             let poses = features_to_joints(&model.normalizer.denormalize(&normalized));
             let mut review = match scorer {
                 Some(s) => reviewer::judge_offline(segment, &poses, &normalized, s),
@@ -252,13 +257,15 @@ pub async fn run<T: Transport>(
                     seed,
                 });
             }
-            let after = segment_score(model, scorer, segment, &candidate).await;
+            let decoded = model.spam.decode(&candidate).await;
+            let after = scorer.map(|s| s.segment_score(segment, &decoded));
             let accepted = match (current, after) {
                 (Some(before), Some(after)) => after >= before,
                 _ => true,
             };
             if accepted {
                 tokens = candidate;
+                normalized = decoded;
                 current = after;
                 history.extend(edits);
             }
@@ -294,20 +301,6 @@ pub async fn run<T: Transport>(
         history,
         tokens,
         notes,
-    }
-}
-
-/// The evaluator's 0–100 similarity of `segment`'s text with `tokens`' motion, where there is
-/// an evaluator.
-async fn segment_score(
-    model: &MotionModel,
-    scorer: Option<&Scorer<'_>>,
-    segment: &Segment,
-    tokens: &MotionTokens,
-) -> Option<f64> {
-    match scorer {
-        Some(s) => Some(s.segment_score(segment, &model.spam.decode(tokens).await)),
-        None => None,
     }
 }
 
