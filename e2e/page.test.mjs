@@ -32,6 +32,19 @@ const ARGS = [
   "--no-first-run", "--disable-quic",
 ];
 
+/** Starts `coma serve` on PORT. */
+function serve() {
+  return spawn(COMA, ["serve", DIST, "--port", String(PORT)], { stdio: "inherit" });
+}
+
+/** Stops the server and waits until it has exited, so the next test can take the port. */
+async function stop(server) {
+  if (server.exitCode !== null || server.signalCode !== null) return;
+  const exited = new Promise((r) => server.once("exit", r));
+  server.kill();
+  await exited;
+}
+
 async function waitForServer() {
   for (let i = 0; i < 100; i++) {
     try {
@@ -71,7 +84,7 @@ async function canvasPixels(page) {
 }
 
 test("the page generates, plays, shares, rebuilds and exports a motion", { timeout: 30 * 60_000 }, async () => {
-  const server = spawn(COMA, ["serve", DIST, "--port", String(PORT)], { stdio: "inherit" });
+  const server = serve();
   const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
   try {
     await waitForServer();
@@ -165,6 +178,12 @@ test("the page generates, plays, shares, rebuilds and exports a motion", { timeo
     const history = await page.locator("#history li").allTextContents();
     assert.ok(history.some((l) => /^left arm ←/.test(l)) && history.some((l) => /^blend/.test(l)), history.join(" | "));
     assert.deepEqual(await fourth.page.locator("#history li").allTextContents(), history, "the link keeps the edit history");
+    // And the run's record: its steps, the review's scores per segment and the notes.
+    assert.deepEqual(await fourth.page.locator("#steps li").allTextContents(), steps, "the link keeps the run's steps");
+    const scores = await page.locator(".plan .score").allTextContents();
+    assert.ok(scores.length > 0 && scores.every((l) => /^review: \d+/.test(l)), scores.join(" | "));
+    assert.deepEqual(await fourth.page.locator(".plan .score").allTextContents(), scores, "the link keeps the review's scores");
+    assert.deepEqual(await fourth.page.locator("#notes li").allTextContents(), await page.locator("#notes li").allTextContents());
 
     // An LLM that cannot be reached: the built-in planner's plan is used, the notes say why,
     // and the API key stays out of the link and the page.
@@ -203,12 +222,12 @@ test("the page generates, plays, shares, rebuilds and exports a motion", { timeo
     }
   } finally {
     await browser.close();
-    server.kill();
+    await stop(server);
   }
 });
 
 test("SPAM runs on the browser's WebGPU when the page is asked to", { timeout: 30 * 60_000 }, async () => {
-  const server = spawn(COMA, ["serve", DIST, "--port", String(PORT)], { stdio: "inherit" });
+  const server = serve();
   const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
   try {
     await waitForServer();
@@ -248,6 +267,6 @@ test("SPAM runs on the browser's WebGPU when the page is asked to", { timeout: 3
     }
   } finally {
     await browser.close();
-    server.kill();
+    await stop(server);
   }
 });

@@ -217,6 +217,7 @@ fn on_reply(state: AppState, reply: Reply) {
             state.generate_millis.set(Some(millis));
             let mut take = Take::new(motion, prompt, seed, history, Some(plan), Vec::new());
             take.scores = scores;
+            take.steps = state.steps.get_untracked();
             let summary = match notes.first() {
                 None => format!("Done in {:.1} s.", millis / 1000.0),
                 Some(first) => format!(
@@ -255,7 +256,10 @@ fn on_reply(state: AppState, reply: Reply) {
                 Some(Pending::Link(link)) => {
                     let (plan, legacy) =
                         plan_from_link(&link.plan, &link.prompt, motion.joints.len());
-                    Take::new(motion, link.prompt, link.seed, link.history, plan, legacy)
+                    let mut take =
+                        Take::new(motion, link.prompt, link.seed, link.history, plan, legacy);
+                    take.restore_record(&link.record);
+                    take
                 }
                 Some(Pending::Run { .. }) | None => return,
             };

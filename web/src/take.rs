@@ -6,6 +6,7 @@ use crate::messages::{Motion, SegmentScores};
 use coma::agents::plan::Plan;
 use coma::model::motion_model::frames_for_seconds;
 use coma::share::{Edit, EditKind, SharedMotion};
+use serde::{Deserialize, Serialize};
 
 /// Frames per token step: segments start and end on whole steps.
 const STEP_FRAMES: usize = 4;
@@ -44,6 +45,34 @@ pub struct Take {
     pub notes: Vec<String>,
     /// The review's scores per segment (cleared by an edit, which they no longer describe).
     pub scores: Vec<SegmentScores>,
+    /// The lines of the run that made the take, one a step (plan, generation, edits, review
+    /// rounds, blend), as the Steps panel showed them.
+    pub steps: Vec<String>,
+}
+
+/// How the run of a take went, as its share link keeps it (the link's `record`), so that
+/// an opened link shows the same steps, scores and notes.
+#[derive(Debug, Default, PartialEq, Serialize, Deserialize)]
+struct RunRecord {
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    steps: Vec<String>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    scores: Vec<SegmentScores>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    notes: Vec<String>,
+}
+
+/// Most lines a record keeps of each kind, and characters a line: what one run writes is far
+/// below both, so only a doctored link is cut.
+const RECORD_LINES: usize = 200;
+const RECORD_LINE_CHARS: usize = 500;
+
+fn capped(lines: Vec<String>) -> Vec<String> {
+    lines
+        .into_iter()
+        .take(RECORD_LINES)
+        .map(|l| l.chars().take(RECORD_LINE_CHARS).collect())
+        .collect()
 }
 
 impl Take {
@@ -71,6 +100,39 @@ impl Take {
             segments,
             notes: Vec::new(),
             scores: Vec::new(),
+            steps: Vec::new(),
+        }
+    }
+
+    /// The take's run record as JSON ("" when it has none).
+    fn record_json(&self) -> String {
+        let record = RunRecord {
+            steps: self.steps.clone(),
+            scores: self.scores.clone(),
+            notes: self.notes.clone(),
+        };
+        if record == RunRecord::default() {
+            return String::new();
+        }
+        serde_json::to_string(&record).unwrap_or_default()
+    }
+
+    /// Takes the steps, scores and notes a link recorded. A record that does not read leaves
+    /// them empty and says so in the notes: the motion itself is whole without it.
+    pub fn restore_record(&mut self, json: &str) {
+        if json.is_empty() {
+            return;
+        }
+        match serde_json::from_str::<RunRecord>(json) {
+            Ok(record) => {
+                self.steps = capped(record.steps);
+                self.notes = capped(record.notes);
+                self.scores = record.scores.into_iter().take(RECORD_LINES).collect();
+            }
+            Err(e) => self.notes.push(format!(
+                "the link's record of its run does not read ({e}), so its steps and review \
+                 scores are not shown"
+            )),
         }
     }
 
@@ -94,6 +156,7 @@ impl Take {
             seed: self.seed,
             prompt: self.prompt.clone(),
             plan: self.plan_json(),
+            record: self.record_json(),
             history: self.edits.clone(),
             tokens: self.motion.tokens.clone(),
         }
@@ -285,6 +348,70 @@ mod tests {
         let json = serde_json::to_string(&plan).unwrap();
         let (read, again) = plan_from_link(&json, "p", 240);
         assert_eq!((read.as_ref(), again), (Some(&plan), segments));
+    }
+
+    #[test]
+    fn a_link_keeps_the_run_record_and_a_bad_record_leaves_a_note() {
+        let motion = Motion {
+            tokens: vec![vec![vec![7; 5]; 2]; 4],
+            joints: vec![[[0.0; 3]; 22]; 20],
+            features: Vec::new(),
+        };
+        let mut take = Take::new(
+            motion.clone(),
+            "a person bows".into(),
+            3,
+            Vec::new(),
+            None,
+            Vec::new(),
+        );
+        assert_eq!(
+            take.record_json(),
+            "",
+            "a take without a run records nothing"
+        );
+        take.steps = vec![
+            "segment 1: generated".into(),
+            "segment 1, review round 1: kept".into(),
+        ];
+        take.notes = vec!["'bows' is read as 'a person bows'".into()];
+        take.scores = vec![SegmentScores {
+            before: Some(28.5),
+            after: Some(33.0),
+            rounds: 1,
+            kept: 1,
+        }];
+        let link = coma::share::decode(&coma::share::encode(&take.shared([1; 8]))).unwrap();
+        let mut opened = Take::new(
+            motion.clone(),
+            link.prompt,
+            link.seed,
+            link.history,
+            None,
+            Vec::new(),
+        );
+        opened.restore_record(&link.record);
+        assert_eq!(
+            (&opened.steps, &opened.notes, &opened.scores),
+            (&take.steps, &take.notes, &take.scores)
+        );
+
+        let mut doctored = Take::new(motion, "p".into(), 0, Vec::new(), None, Vec::new());
+        doctored.restore_record(&format!(
+            r#"{{"steps": ["{}"], "scores": 5}}"#,
+            "x".repeat(10)
+        ));
+        assert!(doctored.steps.is_empty() && doctored.scores.is_empty());
+        assert!(
+            doctored.notes[0].contains("does not read"),
+            "{:?}",
+            doctored.notes
+        );
+        doctored.restore_record(
+            &serde_json::json!({ "steps": vec!["y".repeat(9000); 900] }).to_string(),
+        );
+        assert_eq!(doctored.steps.len(), RECORD_LINES);
+        assert_eq!(doctored.steps[0].len(), RECORD_LINE_CHARS);
     }
 
     #[test]

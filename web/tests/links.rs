@@ -14,6 +14,7 @@ fn sample() -> SharedMotion {
         seed: 42,
         prompt: "a person walks forward, then bows".into(),
         plan: r#"{"segments": []}"#.into(),
+        record: r#"{"steps": ["segment 1: generated"]}"#.into(),
         history: vec![Edit {
             kind: EditKind::Generate,
             text: "a person walks forward".into(),

@@ -9,7 +9,8 @@ pub mod metrics;
 // Measurements run natively, blocking on the model's reads.
 #[cfg(not(target_arch = "wasm32"))]
 pub mod probes;
-#[cfg(not(target_arch = "wasm32"))]
+// The protocol reviews with the agents' pipeline, whose LLM client type is native-only.
+#[cfg(feature = "native")]
 pub mod protocol;
-#[cfg(not(target_arch = "wasm32"))]
+#[cfg(feature = "native")]
 pub mod report;

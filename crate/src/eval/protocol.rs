@@ -1,13 +1,18 @@
 //! The evaluation protocol of `coma eval`: on the test split, each source of motions (the
-//! real test motions, a retrieval baseline, SPAM) answers the test captions, the evaluator
+//! real test motions, a retrieval baseline, SPAM, SPAM with the review loop) answers the test
+//! captions, the evaluator
 //! embeds texts and motions, and the field's metrics are computed, repeated with fresh
 //! caption draws and seeds to give a mean and a 95 % interval per figure.
 
 use super::evaluator::{Evaluator, EvaluatorConfig};
 use super::metrics::{diversity, fid, mm_dist, multimodality, r_precision, Interval};
 use super::probes::foot_skating;
+use crate::agents::llm::{LlmClient, UreqTransport};
+use crate::agents::pipeline::{self, RunOptions};
+use crate::agents::plan::{PartEdits, Plan, PlannerKind, Segment};
+use crate::agents::reviewer::Scorer;
 use crate::executor::block_on;
-use crate::features::{features_to_joints, FeatureFrame};
+use crate::features::{features_to_joints, FeatureFrame, FPS};
 use crate::model::edit::part_text;
 use crate::model::generate::SamplingOptions;
 use crate::model::transformer::TEXT_DIM;
@@ -117,6 +122,49 @@ pub enum Source<'a> {
     Retrieval,
     /// SPAM, generating a motion of the test motion's length from the caption.
     Spam(&'a Spam),
+    /// The same, then reviewed for up to `rounds` rounds by the loop of
+    /// [`crate::agents::pipeline`] with the evaluator as judge (no LLM): the caption is one
+    /// segment. No multimodality (it would cost ten reviewed motions a caption).
+    ReviewedSpam {
+        scorer: &'a Scorer<'a>,
+        rounds: usize,
+    },
+}
+
+/// The motion the review loop makes of one caption, `frames` long (at most 196).
+fn reviewed(
+    scorer: &Scorer,
+    caption: &str,
+    frames: usize,
+    rounds: usize,
+    seed: u64,
+) -> Vec<FeatureFrame> {
+    let segment = Segment {
+        text: caption.to_string(),
+        seconds: frames as f64 / FPS,
+        base: caption.to_string(),
+        parts: PartEdits::default(),
+        trajectory: None,
+    };
+    let plan = Plan {
+        prompt: caption.to_string(),
+        rewritten: caption.to_string(),
+        segments: vec![segment],
+        planner: PlannerKind::Offline,
+        notes: Vec::new(),
+    };
+    block_on(async {
+        let run = pipeline::run(
+            scorer.model,
+            Some(scorer),
+            None::<&LlmClient<UreqTransport>>,
+            plan,
+            RunOptions { rounds, seed },
+            &mut |_| {},
+        )
+        .await;
+        scorer.model.spam.decode(&run.tokens).await
+    })
 }
 
 fn cosine(a: &[f32], b: &[f32]) -> f64 {
@@ -259,6 +307,17 @@ impl Protocol<'_> {
                             options.multimodality_pairs,
                             &mut rng,
                         ));
+                    }
+                    Source::ReviewedSpam { scorer, rounds } => {
+                        generated = captions
+                            .iter()
+                            .enumerate()
+                            .map(|(k, c)| {
+                                let frames = self.test.items[order[k]].features.len().min(196);
+                                reviewed(scorer, c, frames, *rounds, (repeat * 100_000 + k) as u64)
+                            })
+                            .collect();
+                        features = generated.iter().map(Vec::as_slice).collect();
                     }
                 }
                 let motions = self.embed(&features);

@@ -68,7 +68,11 @@ fn describe(name: &str) -> &'static str {
             "the training motion whose caption is nearest (MiniLM cosine) to the test caption"
         }
         "spam" => "SPAM, one shot, a motion of the test motion's length from the caption",
-        "spam_review" => "SPAM with the review loop",
+        "spam_review" => {
+            "the same, then reviewed (up to K rounds, no LLM) with the evaluator as judge; the \
+             judge is the evaluator that measures, so R-precision and MM-Dist favour this row \
+             by construction; no multimodality (ten reviewed motions a caption)"
+        }
         _ => "",
     }
 }

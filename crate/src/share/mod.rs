@@ -1,13 +1,14 @@
 //! Share links: a motion, its prompt, plan and edit history packed into the URL fragment, so
 //! that opening the link rebuilds the same motion with no server and no language model.
 //!
-//! A link's fragment is `m=` + base64url(deflate(payload)), no padding. The payload, version 1:
+//! A link's fragment is `m=` + base64url(deflate(payload)), no padding. The payload, version 2:
 //!
 //! ```text
-//!  "CM" 0x01                      magic and version
+//!  "CM" 0x02                      magic and version
 //!  model id                       8 bytes (the hash of the weights that made the tokens)
 //!  seed                           varint
-//!  prompt, plan                   varint length + UTF-8 each (the plan as JSON, may be empty)
+//!  prompt, plan, record           varint length + UTF-8 each (plan and record as JSON, may
+//!                                   be empty)
 //!  edits                          varint count, then per edit:
 //!                                   kind u8, text, from and to frame (varints),
 //!                                   body-part mask u8 (bit p = part p), seed varint
@@ -15,6 +16,8 @@
 //!                                   then parts × layers × steps codes of 9 bits, packed
 //!                                   little-endian, part-major, then layer, then step
 //! ```
+//!
+//! Version 1 is the same without the record; links in it still open.
 //!
 //! Decoding never panics on any input and caps every size before it allocates, so a hostile
 //! link costs at most a few hundred kilobytes and a clear error.
@@ -25,7 +28,9 @@ use crate::model::generate::MotionTokens;
 use serde::{Deserialize, Serialize};
 
 /// The payload version this code writes.
-pub const VERSION: u8 = 1;
+pub const VERSION: u8 = 2;
+/// The first version, without the run record.
+const VERSION_1: u8 = 1;
 const MAGIC: &[u8; 2] = b"CM";
 /// Longest fragment accepted, characters.
 pub const MAX_LINK_CHARS: usize = 96 * 1024;
@@ -33,7 +38,7 @@ pub const MAX_LINK_CHARS: usize = 96 * 1024;
 pub const MAX_PAYLOAD: usize = 512 * 1024;
 /// Longest prompt or edit text, bytes.
 pub const MAX_TEXT: usize = 4 * 1024;
-/// Longest plan, bytes.
+/// Longest plan, and longest run record, bytes.
 pub const MAX_PLAN: usize = 64 * 1024;
 /// Most edits in a history.
 pub const MAX_EDITS: usize = 256;
@@ -100,6 +105,9 @@ pub struct SharedMotion {
     pub prompt: String,
     /// The plan as JSON ("" when there was none).
     pub plan: String,
+    /// How the run went, as JSON the page writes and reads (its step lines, the review's
+    /// scores per segment, its notes); "" when there is none. Opaque here.
+    pub record: String,
     pub history: Vec<Edit>,
     /// Final tokens `[part][layer][step]`.
     pub tokens: MotionTokens,
@@ -177,6 +185,7 @@ fn payload(motion: &SharedMotion) -> Vec<u8> {
     put_varint(&mut out, motion.seed);
     put_text(&mut out, truncate(&motion.prompt, MAX_TEXT));
     put_text(&mut out, truncate(&motion.plan, MAX_PLAN));
+    put_text(&mut out, truncate(&motion.record, MAX_PLAN));
     let edits = &motion.history[..motion.history.len().min(MAX_EDITS)];
     put_varint(&mut out, edits.len() as u64);
     for e in edits {
@@ -334,7 +343,7 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
         return Err(LinkError::BadMagic);
     }
     let version = r.byte()?;
-    if version != VERSION {
+    if version != VERSION && version != VERSION_1 {
         return Err(LinkError::UnknownVersion(version));
     }
     let mut model_id = [0u8; 8];
@@ -342,6 +351,11 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
     let seed = r.varint()?;
     let prompt = r.text(MAX_TEXT, "prompt")?;
     let plan = r.text(MAX_PLAN, "plan")?;
+    let record = if version == VERSION_1 {
+        String::new()
+    } else {
+        r.text(MAX_PLAN, "run record")?
+    };
     let count = r.bounded(MAX_EDITS as u64, "the number of edits")?;
     let mut history = Vec::with_capacity(count);
     for _ in 0..count {
@@ -417,6 +431,7 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
         seed,
         prompt,
         plan,
+        record,
         history,
         tokens,
     })

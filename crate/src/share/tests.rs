@@ -8,6 +8,7 @@ fn sample(steps: usize) -> SharedMotion {
         seed: 42,
         prompt: "a person walks forward waving the left hand, then bows — «politely»".into(),
         plan: r#"{"segments":[{"text":"walk forward","seconds":4.0}]}"#.into(),
+        record: r#"{"steps":["segment 1: generated"],"scores":[{"before":31.5}]}"#.into(),
         history: vec![
             Edit {
                 kind: EditKind::Generate,
@@ -83,7 +84,7 @@ fn broken_links_give_clear_errors() {
         )
     };
     let mut future = payload(&sample(10));
-    future[2] = 2;
+    future[2] = 3;
     let mut header = b"CM\x01".to_vec();
     header.extend_from_slice(&id);
     let cases: Vec<(String, LinkError)> = vec![
@@ -103,7 +104,7 @@ fn broken_links_give_clear_errors() {
         ),
         (link(b"XY\x01"), LinkError::BadMagic),
         (link(b""), LinkError::BadMagic),
-        (link(&future), LinkError::UnknownVersion(2)),
+        (link(&future), LinkError::UnknownVersion(3)),
         (link(&header), LinkError::Truncated),
         (
             good[..good.len() / 2].to_string(),
@@ -120,9 +121,23 @@ fn broken_links_give_clear_errors() {
         }
     }
     // Every error reads as a sentence for the page.
-    assert!(LinkError::UnknownVersion(2)
+    assert!(LinkError::UnknownVersion(3)
         .to_string()
         .contains("newer version"));
+}
+
+#[test]
+fn links_of_the_first_version_still_open() {
+    // Version 1 is version 2 without the record: cut the record out of a version 2 payload.
+    let mut motion = sample(7);
+    motion.record = String::new();
+    let v2 = payload(&motion);
+    let record_at = 3 + 8 + 1 + (1 + motion.prompt.len()) + (1 + motion.plan.len());
+    assert_eq!(v2[record_at], 0, "an empty record is one zero length byte");
+    let mut v1 = v2.clone();
+    v1.remove(record_at);
+    v1[2] = 1;
+    assert_eq!(parse_payload(&v1).unwrap(), motion);
 }
 
 #[test]

@@ -1,8 +1,9 @@
-//! The steps of the last run as they came (plan, generation, edits, reviews, blend), the
-//! current take's edit history (what its link carries), and what its planner and run noted: an LLM that failed and the built-in planner that
-//! took over, words the model does not know, a review that was skipped.
+//! The steps of a run as they come (plan, generation, edits, reviews, blend), then those of
+//! the take shown, its edit history, and what its planner and run noted: an LLM that failed
+//! and the built-in planner that took over, words the model does not know, a review that was
+//! skipped. A take's link carries all of it.
 
-use crate::app::AppState;
+use crate::app::{AppState, Pending};
 use crate::take::edit_line;
 use coma::agents::plan::PlannerKind;
 use leptos::prelude::*;
@@ -36,7 +37,22 @@ pub fn Steps() -> impl IntoView {
             .with(|h| h.current().as_ref().map(|t| t.edits.clone()))
             .unwrap_or_default()
     };
-    let visible = move || state.steps.with(|s| !s.is_empty()) || planner().is_some();
+    // The live lines while a run is in flight, else those of the take shown (its link keeps
+    // them, and undo brings back each take's own).
+    let lines = move || {
+        if state
+            .pending
+            .with(|p| matches!(p, Some(Pending::Run { .. })))
+        {
+            state.steps.get()
+        } else {
+            state
+                .history
+                .with(|h| h.current().as_ref().map(|t| t.steps.clone()))
+                .unwrap_or_default()
+        }
+    };
+    let visible = move || !lines().is_empty() || planner().is_some();
     view! {
         <Show when=visible>
             <details class="panel steps" open>
@@ -44,9 +60,7 @@ pub fn Steps() -> impl IntoView {
                 {move || planner().map(|p| view! { <p class="planner">{p}</p> })}
                 <ol id="steps">
                     {move || {
-                        state
-                            .steps
-                            .get()
+                        lines()
                             .into_iter()
                             .map(|line| view! { <li>{line}</li> })
                             .collect_view()

@@ -84,6 +84,10 @@ enum Command {
         /// Filmstrip PNG to write.
         #[arg(long)]
         png: Option<PathBuf>,
+        /// Classifier-free guidance scale of the base transformer: 1 follows the learnt
+        /// conditional distribution, more follows the text harder (default 4).
+        #[arg(long)]
+        guidance: Option<f32>,
         #[command(flatten)]
         model: ModelArgs,
     },
@@ -191,7 +195,8 @@ enum Command {
         /// Prompt set for the planner and the review loop.
         #[arg(long, default_value = "eval/prompts.json")]
         prompts: PathBuf,
-        /// Review rounds (K) of the review-loop measurement; 0 skips it.
+        /// Review rounds (K) of the review loop's measurements (the spam_review row and the
+        /// prompt set); 0 skips them.
         #[arg(long, default_value_t = 2)]
         review_rounds: usize,
         #[arg(long, default_value = "EVAL.md")]
@@ -862,9 +867,23 @@ fn evaluate(
     }
     eprintln!("embedded {} distinct captions", sentences.len());
     let spam = spam_dir.map(load_model).transpose()?;
+    let scorer = spam.as_ref().map(|model| coma::agents::reviewer::Scorer {
+        evaluator: &evaluator,
+        config: &config,
+        model,
+    });
     let mut sources = vec![("real", Source::Real), ("retrieval", Source::Retrieval)];
-    if let Some(model) = &spam {
+    if let (Some(model), Some(scorer)) = (&spam, &scorer) {
         sources.push(("spam", Source::Spam(&model.spam)));
+        if agent_options.review_rounds > 0 {
+            sources.push((
+                "spam_review",
+                Source::ReviewedSpam {
+                    scorer,
+                    rounds: agent_options.review_rounds,
+                },
+            ));
+        }
     }
     let protocol = Protocol {
         evaluator: &evaluator,
@@ -1080,12 +1099,24 @@ fn run(cli: Cli) -> Result<()> {
             parts,
             out,
             png,
+            guidance,
             model,
         } => {
             let parts = parse_parts(&parts)?;
             let model = load_model(&model.models)?;
             let frames = coma::model::motion_model::frames_for_seconds(seconds);
-            let tokens = block_on(model.generate(&prompt, &parts, frames, seed));
+            let tokens = match guidance {
+                None => block_on(model.generate(&prompt, &parts, frames, seed)),
+                Some(g) if g.is_finite() && g >= 0.0 => {
+                    let options = coma::model::generate::SamplingOptions {
+                        base_guidance: g,
+                        ..coma::model::motion_model::sampling(seed)
+                    };
+                    let condition = model.condition(&prompt, &parts);
+                    block_on(model.spam.generate(&condition, frames, &options))
+                }
+                Some(g) => bail!("--guidance must be a number of 0 or more, not {g}"),
+            };
             write_outputs(
                 &block_on(model.features(&tokens)),
                 out.as_deref(),
