@@ -3,11 +3,13 @@
 //! - left/right: over many seeds, raising or waving the left (right) hand must lift the left
 //!   (right) wrist higher than the other;
 //! - edit locality: editing one arm of a motion must leave the legs where they were;
-//! - continuity: the join of two blended segments must not be faster than real motion ever is.
+//! - continuity: the join of two blended segments must not be faster than real motion ever is;
+//! - bow: "a person bows" must bend the trunk forward about as far as the dataset's bows do.
 
 use crate::executor::block_on;
 use crate::features::{FeatureFrame, FPS, POSITIONS};
 use crate::geom::{self, Vec3};
+use crate::model::generate::SamplingOptions;
 use crate::model::motion_model::sampling;
 use crate::model::MotionModel;
 use crate::skeleton::{joint, BodyPart, Pose};
@@ -236,9 +238,85 @@ pub fn continuity(
     }
 }
 
+/// The furthest the trunk leans from upright over a motion: the largest angle, in degrees,
+/// between the pelvis-to-head line and the vertical (Y up). About 15° for a walk; a bow is a
+/// forward lean well beyond it.
+pub fn trunk_lean(poses: &[Pose]) -> f64 {
+    poses
+        .iter()
+        .map(|p| {
+            let v = geom::sub(p[joint::HEAD], p[joint::PELVIS]);
+            v[0].hypot(v[2]).atan2(v[1]).to_degrees()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Result of the bow probe for one guidance scale.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BowReport {
+    pub guidance: f32,
+    /// [`trunk_lean`] of each seed's "a person bows", degrees.
+    pub leans: Vec<f64>,
+    /// Share of seeds that lean at least as far as the 10th percentile of real bows.
+    pub bowing: f64,
+}
+
+/// Generates "a person bows" (`seconds` long) with each seed at each guidance scale of the
+/// base transformer, and measures how far each leans against `real_p10`, the 10th percentile
+/// of the real bows' [`trunk_lean`].
+pub fn bow(
+    model: &MotionModel,
+    seeds: u64,
+    seconds: f64,
+    guidance: &[f32],
+    real_p10: f64,
+) -> Vec<BowReport> {
+    let prompt = "a person bows";
+    let condition = model.condition(prompt, &[]);
+    let frames = (seconds * FPS) as usize;
+    guidance
+        .iter()
+        .map(|&g| {
+            let leans: Vec<f64> = (0..seeds)
+                .map(|seed| {
+                    let options = SamplingOptions {
+                        base_guidance: g,
+                        ..sampling(seed)
+                    };
+                    block_on(async {
+                        let tokens = model.spam.generate(&condition, frames, &options).await;
+                        trunk_lean(&model.joints(&tokens).await)
+                    })
+                })
+                .collect();
+            let bowing =
+                leans.iter().filter(|&&l| l >= real_p10).count() as f64 / leans.len().max(1) as f64;
+            BowReport {
+                guidance: g,
+                leans,
+                bowing,
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_upright_trunk_leans_zero_and_a_bent_one_its_angle() {
+        let mut upright = [[0.0; 3]; 22];
+        upright[joint::HEAD] = [0.0, 0.6, 0.0];
+        let mut bent = upright;
+        // Head as far forward (+Z) as it is above the pelvis: 45°.
+        bent[joint::HEAD] = [0.0, 0.4, 0.4];
+        assert!(trunk_lean(&[upright]).abs() < 1e-9);
+        assert!((trunk_lean(&[upright, bent, upright]) - 45.0).abs() < 1e-9);
+        // Sideways counts the same as forward.
+        bent[joint::HEAD] = [-0.3, 0.3 * 3f64.sqrt(), 0.0];
+        assert!((trunk_lean(&[bent]) - 30.0).abs() < 1e-9);
+    }
 
     #[test]
     fn quantiles_and_speeds() {

@@ -386,6 +386,19 @@ enum ProbeCommand {
         #[command(flatten)]
         model: ModelArgs,
     },
+    /// "A person bows" over many seeds: how far the trunk leans, against the dataset's bows.
+    Bow {
+        #[arg(long, default_value_t = 20)]
+        seeds: u64,
+        /// Guidance scales of the base transformer to try (repeat for a sweep).
+        #[arg(long, default_values_t = [coma::model::generate::SamplingOptions::default().base_guidance])]
+        guidance: Vec<f32>,
+        /// Dataset whose training bows are the reference.
+        #[arg(long, default_value = "data/bandai")]
+        data: PathBuf,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
     /// Blend two segments: speeds at the join against real motion's 99th percentile.
     Continuity {
         /// Dataset whose test motions give the reference speeds.
@@ -446,6 +459,7 @@ fn probe(command: ProbeCommand) -> Result<()> {
     let models = match &command {
         ProbeCommand::Leftright { model, .. }
         | ProbeCommand::Locality { model, .. }
+        | ProbeCommand::Bow { model, .. }
         | ProbeCommand::Continuity { model, .. } => model.models.clone(),
     };
     let generator = load_model(&models)?;
@@ -472,6 +486,49 @@ fn probe(command: ProbeCommand) -> Result<()> {
                 "left wrist rises {:.1} cm more after the edit",
                 r.left_wrist_rise_gain_cm
             );
+        }
+        ProbeCommand::Bow {
+            seeds,
+            guidance,
+            data,
+            ..
+        } => {
+            use coma::eval::probes::{bow, quantile, trunk_lean};
+            let set = coma::train::motions::MotionSet::load(&data, coma::dataset::Split::Train)?;
+            let real: Vec<f64> = set
+                .items
+                .iter()
+                .filter(|i| {
+                    i.captions
+                        .iter()
+                        .any(|c| c.split_whitespace().any(|w| w.starts_with("bow")))
+                })
+                .map(|i| {
+                    trunk_lean(&coma::features::features_to_joints(
+                        &set.normalizer.denormalize(&i.features),
+                    ))
+                })
+                .collect();
+            anyhow::ensure!(
+                !real.is_empty(),
+                "no bows among the training motions of {}",
+                data.display()
+            );
+            let p10 = quantile(real.clone(), 0.1);
+            println!(
+                "real bows ({} training motions): trunk lean median {:.0}°, 10th percentile {p10:.0}°",
+                real.len(),
+                quantile(real, 0.5)
+            );
+            for r in bow(&generator, seeds, 4.0, &guidance, p10) {
+                println!(
+                    "\"a person bows\", guidance {}: trunk lean median {:.0}° over {} seeds, {:.0} % lean at least {p10:.0}°",
+                    r.guidance,
+                    quantile(r.leans.clone(), 0.5),
+                    r.leans.len(),
+                    r.bowing * 100.0
+                );
+            }
         }
         ProbeCommand::Continuity { data, seed, .. } => {
             let set = coma::train::motions::MotionSet::load(&data, coma::dataset::Split::Test)?;
