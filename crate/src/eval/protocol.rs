@@ -1,8 +1,7 @@
 //! The evaluation protocol of `coma eval`: on the test split, each source of motions (the
 //! real test motions, a retrieval baseline, SPAM, SPAM with the review loop) answers the test
-//! captions, the evaluator
-//! embeds texts and motions, and the field's metrics are computed, repeated with fresh
-//! caption draws and seeds to give a mean and a 95 % interval per figure.
+//! captions, the evaluator embeds texts and motions, and the field's metrics are computed,
+//! repeated with fresh caption draws and seeds to give a mean and a 95 % interval per figure.
 
 use super::evaluator::{Evaluator, EvaluatorConfig};
 use super::metrics::{diversity, fid, mm_dist, multimodality, r_precision, Interval};
