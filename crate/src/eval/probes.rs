@@ -271,8 +271,6 @@ pub fn bow(
     guidance: &[f32],
     real_p10: f64,
 ) -> Vec<BowReport> {
-    let prompt = "a person bows";
-    let condition = model.condition(prompt, &[]);
     let frames = (seconds * FPS) as usize;
     guidance
         .iter()
@@ -284,7 +282,9 @@ pub fn bow(
                         ..sampling(seed)
                     };
                     block_on(async {
-                        let tokens = model.spam.generate(&condition, frames, &options).await;
+                        let tokens = model
+                            .generate_with("a person bows", &[], frames, &options)
+                            .await;
                         trunk_lean(&model.joints(&tokens).await)
                     })
                 })

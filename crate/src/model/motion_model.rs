@@ -93,11 +93,23 @@ impl MotionModel {
         frames: usize,
         seed: u64,
     ) -> MotionTokens {
+        self.generate_with(prompt, parts, frames, &sampling(seed))
+            .await
+    }
+
+    /// The same with sampling options of one's own (guidance scales, temperature).
+    pub async fn generate_with(
+        &self,
+        prompt: &str,
+        parts: &[(BodyPart, String)],
+        frames: usize,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
         self.spam
             .generate(
                 &self.condition(prompt, parts),
                 frames.clamp(4, MAX_FRAMES),
-                &sampling(seed),
+                options,
             )
             .await
     }

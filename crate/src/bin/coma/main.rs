@@ -1162,18 +1162,13 @@ fn run(cli: Cli) -> Result<()> {
             let parts = parse_parts(&parts)?;
             let model = load_model(&model.models)?;
             let frames = coma::model::motion_model::frames_for_seconds(seconds);
-            let tokens = match guidance {
-                None => block_on(model.generate(&prompt, &parts, frames, seed)),
-                Some(g) if g.is_finite() && g >= 0.0 => {
-                    let options = coma::model::generate::SamplingOptions {
-                        base_guidance: g,
-                        ..coma::model::motion_model::sampling(seed)
-                    };
-                    let condition = model.condition(&prompt, &parts);
-                    block_on(model.spam.generate(&condition, frames, &options))
-                }
+            let mut options = coma::model::motion_model::sampling(seed);
+            match guidance {
+                Some(g) if g.is_finite() && g >= 0.0 => options.base_guidance = g,
                 Some(g) => bail!("--guidance must be a number of 0 or more, not {g}"),
-            };
+                None => {}
+            }
+            let tokens = block_on(model.generate_with(&prompt, &parts, frames, &options));
             write_outputs(
                 &block_on(model.features(&tokens)),
                 out.as_deref(),
