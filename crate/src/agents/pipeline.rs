@@ -210,7 +210,7 @@ pub async fn run<T: Transport>(
                 },
             };
             if let Some(client) = llm {
-                review = reviewer::judge_llm(client, segment, review).await;
+                review = reviewer::review_llm(client, segment, &poses, review).await;
             } else if scorer.is_none() {
                 break;
             }

@@ -209,7 +209,7 @@ fn judge_messages(segment: &Segment, description: &str) -> Vec<Message> {
 }
 
 /// The LLM judge; on any failure the offline review stands, with a note saying why.
-pub async fn judge_llm<T: Transport>(
+async fn judge_llm<T: Transport>(
     client: &LlmClient<T>,
     segment: &Segment,
     offline: Review,
@@ -268,11 +268,45 @@ pub async fn judge_llm<T: Transport>(
     }
 }
 
+/// The LLM's review of a segment: when the configuration names a vision model, it first looks
+/// at a filmstrip of `poses` (metres, Y up, 20 fps) and its words join the pose codes; then the
+/// LLM judges. Whatever fails leaves a note and the rest of the review stands.
+pub async fn review_llm<T: Transport>(
+    client: &LlmClient<T>,
+    segment: &Segment,
+    poses: &[Pose],
+    offline: Review,
+) -> Review {
+    let mut offline = offline;
+    let mut vision_note = None;
+    if client.config().vision_model.is_some() {
+        match describe_with_vision(client, poses).await {
+            Ok(words) => {
+                offline.description = format!(
+                    "{}\nA vision model looking at a filmstrip of it says: {words}",
+                    offline.description
+                )
+            }
+            Err(e) => {
+                vision_note = Some(format!(
+                    "the vision describer failed ({e}); the pose codes described"
+                ))
+            }
+        }
+    }
+    let mut review = judge_llm(client, segment, offline).await;
+    review.note = match (vision_note, review.note.take()) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    };
+    review
+}
+
 /// Frames shown to a vision model: enough to see the movement, few enough to stay cheap.
 pub const VISION_FRAMES: usize = 8;
 
-/// Asks the configured vision model to describe a filmstrip of the motion; `None` (with the
-/// reason) when it cannot, in which case the pose-code description stands.
+/// Asks the configured vision model to describe a filmstrip of the motion (metres, Y up,
+/// 20 fps); the reason when it cannot.
 pub async fn describe_with_vision<T: Transport>(
     client: &LlmClient<T>,
     poses: &[Pose],
@@ -398,6 +432,109 @@ mod tests {
                 .unwrap_or("")
                 .contains("evaluator judged"));
         }
+    }
+
+    fn vision_client(server: &ScriptServer) -> LlmClient<crate::agents::llm::UreqTransport> {
+        let mut config = LlmConfig::new(server.base_url(), "judge");
+        config.max_retries = 0;
+        config.vision_model = Some("eyes".into());
+        LlmClient::native(config).unwrap()
+    }
+
+    fn walking_poses() -> Vec<Pose> {
+        let mut pose = [[0.0; 3]; crate::skeleton::NUM_JOINTS];
+        for (j, p) in pose.iter_mut().enumerate() {
+            *p = [0.1 * (j % 3) as f64, 1.0 - 0.05 * j as f64, 0.0];
+        }
+        (0..40)
+            .map(|t| {
+                let mut p = pose;
+                for joint in p.iter_mut() {
+                    joint[2] += 0.03 * t as f64;
+                }
+                p
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_vision_model_looks_before_the_judge_reads() {
+        let server = ScriptServer::start([
+            ScriptedReply::completion("The figure strides forward, its left arm swinging high."),
+            ScriptedReply::completion(
+                r#"{"left_arm": null, "right_arm": null, "lower_body": null}"#,
+            ),
+        ])
+        .unwrap();
+        let client = vision_client(&server);
+        let review = block_on(review_llm(
+            &client,
+            &segment(),
+            &walking_poses(),
+            offline_review(),
+        ));
+        assert_eq!(review.note, None);
+        assert!(review.corrections.is_empty());
+        assert!(review.description.starts_with("A person walks forward."));
+        assert!(review.description.contains("left arm swinging high"));
+        let requests = server.requests();
+        assert_eq!(requests.len(), 2);
+        let looked = requests[0].json();
+        assert_eq!(looked["model"], "eyes");
+        assert!(looked
+            .to_string()
+            .contains("data:image/png;base64,iVBORw0KGgo"));
+        let judged = requests[1].json();
+        assert_eq!(judged["model"], "judge");
+        assert!(judged.to_string().contains("left arm swinging high"));
+    }
+
+    #[test]
+    fn a_failing_vision_model_leaves_the_pose_codes_to_the_judge() {
+        let server = ScriptServer::start([
+            ScriptedReply::error(500, "no eyes today"),
+            ScriptedReply::completion(
+                r#"{"left_arm": "a person waves the left hand", "right_arm": null, "lower_body": null}"#,
+            ),
+        ])
+        .unwrap();
+        let client = vision_client(&server);
+        let review = block_on(review_llm(
+            &client,
+            &segment(),
+            &walking_poses(),
+            offline_review(),
+        ));
+        let note = review.note.unwrap_or_default();
+        assert!(note.contains("vision describer failed"), "{note}");
+        assert_eq!(review.description, offline_review().description);
+        assert_eq!(
+            review.judge,
+            JudgeKind::Llm {
+                model: "judge".into()
+            }
+        );
+        assert_eq!(review.corrections.len(), 1);
+    }
+
+    #[test]
+    fn without_a_vision_model_nothing_is_shown_a_picture() {
+        let server = ScriptServer::start([ScriptedReply::completion(
+            r#"{"left_arm": null, "right_arm": null, "lower_body": null}"#,
+        )])
+        .unwrap();
+        let mut config = LlmConfig::new(server.base_url(), "judge");
+        config.max_retries = 0;
+        let client = LlmClient::native(config).unwrap();
+        block_on(review_llm(
+            &client,
+            &segment(),
+            &walking_poses(),
+            offline_review(),
+        ));
+        let requests = server.requests();
+        assert_eq!(requests.len(), 1);
+        assert!(!requests[0].json().to_string().contains("image_url"));
     }
 
     #[test]

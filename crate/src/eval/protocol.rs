@@ -71,6 +71,8 @@ pub struct Row {
     pub multimodality: Option<Interval>,
     /// Share of frames with a skating foot (see [`super::probes::foot_skating`]).
     pub foot_skating: Interval,
+    /// Repetitions the row was measured on.
+    pub repeats: usize,
 }
 
 /// The metrics of one repetition of one source.
@@ -97,6 +99,7 @@ impl Figures {
             multimodality: (!self.multimodality.is_empty())
                 .then(|| Interval::of(&self.multimodality)),
             foot_skating: Interval::of(&self.skating),
+            repeats: self.top.len(),
         }
     }
 }
@@ -123,10 +126,14 @@ pub enum Source<'a> {
     Spam(&'a Spam),
     /// The same, then reviewed for up to `rounds` rounds by the loop of
     /// [`crate::agents::pipeline`] with the evaluator as judge (no LLM): the caption is one
-    /// segment. No multimodality (it would cost ten reviewed motions a caption).
+    /// segment. No multimodality (it would cost ten reviewed motions a caption). A reviewed
+    /// motion costs several generations, so the row may be measured on only the first
+    /// `repeats` repetitions (same motions per repetition as every other row, so its FID
+    /// compares).
     ReviewedSpam {
         scorer: &'a Scorer<'a>,
         rounds: usize,
+        repeats: usize,
     },
 }
 
@@ -252,6 +259,9 @@ impl Protocol<'_> {
                 .collect();
             let texts = self.evaluator.embed_texts(&sentences, self.device);
             for ((name, source), fig) in sources.iter().zip(&mut figures) {
+                if matches!(source, Source::ReviewedSpam { repeats, .. } if repeat >= *repeats) {
+                    continue;
+                }
                 let features: Vec<&[FeatureFrame]>;
                 let generated: Vec<Vec<FeatureFrame>>;
                 match source {
@@ -307,7 +317,7 @@ impl Protocol<'_> {
                             &mut rng,
                         ));
                     }
-                    Source::ReviewedSpam { scorer, rounds } => {
+                    Source::ReviewedSpam { scorer, rounds, .. } => {
                         generated = captions
                             .iter()
                             .enumerate()

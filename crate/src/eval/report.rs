@@ -108,8 +108,19 @@ impl EvalReport {
         md.push_str("## Text-to-motion metrics\n\n");
         md.push_str(&markdown_table(&self.rows, &ROW_ORDER));
         md.push('\n');
-        for name in ROW_ORDER.iter().filter(|n| self.rows.contains_key(**n)) {
-            md.push_str(&format!("- **{name}**: {}\n", describe(name)));
+        for (name, row) in ROW_ORDER
+            .iter()
+            .filter_map(|n| self.rows.get(*n).map(|r| (n, r)))
+        {
+            let part = if row.repeats < o.repeats {
+                format!(
+                    " (measured on the first {} of the {} repetitions)",
+                    row.repeats, o.repeats
+                )
+            } else {
+                String::new()
+            };
+            md.push_str(&format!("- **{name}**: {}{part}\n", describe(name)));
         }
         md.push_str("\n## Control probes\n\n| probe | figure |\n|---|---|\n");
         let p = &self.probes;
@@ -148,5 +159,55 @@ impl EvalReport {
         }
         md.push_str(&self.agents_markdown);
         md
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::metrics::Interval;
+
+    fn row(repeats: usize) -> Row {
+        let i = Interval {
+            mean: 0.5,
+            ci95: 0.01,
+        };
+        Row {
+            top1: i,
+            top2: i,
+            top3: i,
+            fid: i,
+            mm_dist: i,
+            diversity: i,
+            multimodality: None,
+            foot_skating: i,
+            repeats,
+        }
+    }
+
+    #[test]
+    fn a_row_measured_on_fewer_repetitions_says_so() {
+        let report = EvalReport {
+            command: "coma eval".into(),
+            evaluator_id: "e".into(),
+            spam_id: Some("s".into()),
+            test_motions: 300,
+            options: ProtocolOptions::default(),
+            rows: [("spam".into(), row(10)), ("spam_review".into(), row(3))].into(),
+            probes: Probes::default(),
+            agents: None,
+            agents_markdown: String::new(),
+            seconds: 1.0,
+        };
+        let md = report.markdown();
+        let line = |name: &str| {
+            md.lines()
+                .find(|l| l.starts_with(&format!("- **{name}**")))
+                .unwrap_or_else(|| panic!("no {name} line in\n{md}"))
+                .to_string()
+        };
+        assert!(line("spam_review").ends_with("(measured on the first 3 of the 10 repetitions)"));
+        assert!(!line("spam").contains("measured on"));
+        assert!(report.json().contains("\"repeats\": 3"));
     }
 }

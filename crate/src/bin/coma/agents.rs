@@ -30,6 +30,10 @@ pub struct LlmArgs {
     /// Seconds to wait for one LLM reply.
     #[arg(long, default_value_t = 60.0)]
     timeout: f64,
+    /// A vision model on the same server: during review it is shown a filmstrip of each
+    /// segment and its description goes to the judge with the pose codes.
+    #[arg(long, requires = "llm")]
+    vision_model: Option<String>,
 }
 
 impl LlmArgs {
@@ -45,6 +49,7 @@ impl LlmArgs {
             bail!("--timeout must be a positive number of seconds");
         }
         config.timeout = std::time::Duration::from_secs_f64(self.timeout);
+        config.vision_model = self.vision_model.clone().filter(|m| !m.trim().is_empty());
         Ok(Some(LlmClient::native(config)?))
     }
 }

@@ -199,6 +199,10 @@ enum Command {
         /// prompt set); 0 skips them.
         #[arg(long, default_value_t = 2)]
         review_rounds: usize,
+        /// Repetitions the spam_review row is measured on (the first ones; all if absent): a
+        /// reviewed motion costs several generations.
+        #[arg(long)]
+        review_repeats: Option<usize>,
         #[arg(long, default_value = "EVAL.md")]
         markdown: PathBuf,
         #[arg(long, default_value = "eval.json")]
@@ -659,6 +663,8 @@ fn train_transformer(kind: coma::train::transformer::Kind, args: TransformerArgs
 struct AgentEvalOptions {
     prompts: PathBuf,
     review_rounds: usize,
+    /// Repetitions of the protocol the spam_review row takes part in.
+    review_repeats: usize,
 }
 
 /// The planner on the prompt set; with SPAM, the review loop over it and the circle probe.
@@ -938,6 +944,7 @@ fn evaluate(
                 Source::ReviewedSpam {
                     scorer,
                     rounds: agent_options.review_rounds,
+                    repeats: agent_options.review_repeats,
                 },
             ));
         }
@@ -1259,6 +1266,7 @@ fn run(cli: Cli) -> Result<()> {
             model,
             prompts,
             review_rounds,
+            review_repeats,
         } => {
             let options = coma::eval::protocol::ProtocolOptions {
                 repeats,
@@ -1278,6 +1286,7 @@ fn run(cli: Cli) -> Result<()> {
                 &AgentEvalOptions {
                     prompts,
                     review_rounds,
+                    review_repeats: review_repeats.unwrap_or(repeats),
                 },
             )?;
         }
