@@ -1,5 +1,17 @@
 // The inference worker: the page's own wasm module, run off the UI thread (see web/src/worker.rs).
+// The page posts its compiled WebAssembly.Module as the first message, so the wasm is
+// downloaded and compiled once per page load rather than once by the page and once here.
 import init, { worker_main } from "../pkg/coma_web.js";
 
-await init({ module_or_path: new URL("../pkg/coma_web_bg.wasm", import.meta.url) });
-worker_main();
+self.addEventListener(
+  "message",
+  async (event) => {
+    const module_or_path =
+      event.data instanceof WebAssembly.Module
+        ? event.data
+        : new URL("../pkg/coma_web_bg.wasm", import.meta.url);
+    await init({ module_or_path });
+    worker_main();
+  },
+  { once: true },
+);

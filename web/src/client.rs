@@ -35,6 +35,11 @@ impl Client {
         });
         worker.set_onmessage(Some(on_message.as_ref().unchecked_ref()));
         worker.set_onerror(Some(on_error.as_ref().unchecked_ref()));
+        // static/worker.js waits for this: our compiled module, so the worker neither
+        // downloads nor compiles the wasm a second time.
+        worker
+            .post_message(&wasm_bindgen::module())
+            .map_err(|e| format!("cannot hand the model worker its code: {e:?}"))?;
         Ok(Client {
             worker,
             _on_message: on_message,

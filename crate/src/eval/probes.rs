@@ -4,15 +4,17 @@
 //!   (right) wrist higher than the other;
 //! - edit locality: editing one arm of a motion must leave the legs where they were;
 //! - continuity: the join of two blended segments must not be faster than real motion ever is;
-//! - bow: "a person bows" must bend the trunk forward about as far as the dataset's bows do.
+//! - actions: "a person bows" must bend the trunk forward about as far as the dataset's bows
+//!   do, "a person waves the left hand" must move that hand about as much as its waves do.
 
 use crate::executor::block_on;
-use crate::features::{FeatureFrame, FPS, POSITIONS};
+use crate::features::{features_to_joints, FeatureFrame, FPS, POSITIONS};
 use crate::geom::{self, Vec3};
 use crate::model::generate::SamplingOptions;
 use crate::model::motion_model::sampling;
 use crate::model::MotionModel;
 use crate::skeleton::{joint, BodyPart, Pose};
+use crate::train::motions::MotionSet;
 
 /// Result of the left/right probe.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -251,31 +253,92 @@ pub fn trunk_lean(poses: &[Pose]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Result of the bow probe for one guidance scale.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct BowReport {
-    pub guidance: f32,
-    /// [`trunk_lean`] of each seed's "a person bows", degrees.
-    pub leans: Vec<f64>,
-    /// Share of seeds that lean at least as far as the 10th percentile of real bows.
-    pub bowing: f64,
+/// How fast the left wrist moves about the pelvis, in m/s, averaged over the motion: a wave
+/// swings it back and forth; a walk's arm swing is slower, standing still is near zero.
+pub fn left_wrist_speed(poses: &[Pose]) -> f64 {
+    let relative: Vec<Vec3> = poses
+        .iter()
+        .map(|p| geom::sub(p[joint::L_WRIST], p[joint::PELVIS]))
+        .collect();
+    if relative.len() < 2 {
+        return 0.0;
+    }
+    let path: f64 = relative
+        .windows(2)
+        .map(|w| geom::norm(geom::sub(w[1], w[0])))
+        .sum();
+    path * FPS / (relative.len() - 1) as f64
 }
 
-/// Generates "a person bows" (`seconds` long) with each seed at each guidance scale of the
-/// base transformer, and measures how far each leans against `real_p10`, the 10th percentile
-/// of the real bows' [`trunk_lean`].
-pub fn bow(
+/// An action of the dataset, the prompt asking for it, and one number saying how much of it a
+/// motion performs, so generated motions can be held against the dataset's own performances.
+pub struct ActionProbe {
+    pub prompt: &'static str,
+    /// The dataset's content label of the real performances (see `dataset.json`).
+    pub content: &'static str,
+    /// What [`ActionProbe::measure`] gives, and its unit.
+    pub measure_name: &'static str,
+    pub unit: &'static str,
+    pub measure: fn(&[Pose]) -> f64,
+}
+
+/// "A person bows", by the [`trunk_lean`] (degrees).
+pub const BOW: ActionProbe = ActionProbe {
+    prompt: "a person bows",
+    content: "bow",
+    measure_name: "trunk lean",
+    unit: "°",
+    measure: trunk_lean,
+};
+
+/// "A person waves the left hand", by the [`left_wrist_speed`] (m/s).
+pub const LEFT_WAVE: ActionProbe = ActionProbe {
+    prompt: "a person waves the left hand",
+    content: "wave-left-hand",
+    measure_name: "left-wrist speed about the pelvis",
+    unit: "m/s",
+    measure: left_wrist_speed,
+};
+
+/// The probe's measure of each motion of `set` that shows its action.
+pub fn real_performances(set: &MotionSet, probe: &ActionProbe) -> Vec<f64> {
+    set.items
+        .iter()
+        .filter(|i| i.content.as_deref() == Some(probe.content))
+        .map(|i| {
+            (probe.measure)(&features_to_joints(
+                &set.normalizer.denormalize(&i.features),
+            ))
+        })
+        .collect()
+}
+
+/// Result of an action probe for one guidance scale.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ActionReport {
+    pub guidance: f32,
+    /// The measure of each seed's motion.
+    pub values: Vec<f64>,
+    /// Share of seeds that reach the 10th percentile of the real performances.
+    pub reaching: f64,
+}
+
+/// Generates the probe's prompt (`seconds` long) with each seed at each guidance scale of the
+/// base transformer, and measures each motion against `real_p10`, the 10th percentile of
+/// [`real_performances`].
+pub fn action(
     model: &MotionModel,
+    probe: &ActionProbe,
     seeds: u64,
     seconds: f64,
     guidance: &[f32],
     real_p10: f64,
-) -> Vec<BowReport> {
+) -> Vec<ActionReport> {
     let frames = (seconds * FPS) as usize;
     guidance
         .iter()
         .map(|&g| {
-            let leans: Vec<f64> = (0..seeds)
+            let values: Vec<f64> = (0..seeds)
                 .map(|seed| {
                     let options = SamplingOptions {
                         base_guidance: g,
@@ -283,18 +346,18 @@ pub fn bow(
                     };
                     block_on(async {
                         let tokens = model
-                            .generate_with("a person bows", &[], frames, &options)
+                            .generate_with(probe.prompt, &[], frames, &options)
                             .await;
-                        trunk_lean(&model.joints(&tokens).await)
+                        (probe.measure)(&model.joints(&tokens).await)
                     })
                 })
                 .collect();
-            let bowing =
-                leans.iter().filter(|&&l| l >= real_p10).count() as f64 / leans.len().max(1) as f64;
-            BowReport {
+            let reaching = values.iter().filter(|&&v| v >= real_p10).count() as f64
+                / values.len().max(1) as f64;
+            ActionReport {
                 guidance: g,
-                leans,
-                bowing,
+                values,
+                reaching,
             }
         })
         .collect()
@@ -303,6 +366,31 @@ pub fn bow(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_left_wrist_speed_is_about_the_pelvis() {
+        // The whole body walks forward at 1.2 m/s: no speed about the pelvis.
+        let walk: Vec<Pose> = (0..20)
+            .map(|t| {
+                let mut p = [[0.0; 3]; 22];
+                for j in p.iter_mut() {
+                    j[2] = 0.06 * t as f64;
+                }
+                p
+            })
+            .collect();
+        assert!(left_wrist_speed(&walk).abs() < 1e-9);
+        // The wrist swings ±0.1 m sideways each frame: 0.2 m a frame, 4 m/s at 20 fps.
+        let wave: Vec<Pose> = (0..21)
+            .map(|t| {
+                let mut p = [[0.0; 3]; 22];
+                p[joint::L_WRIST][0] = if t % 2 == 0 { 0.1 } else { -0.1 };
+                p
+            })
+            .collect();
+        assert!((left_wrist_speed(&wave) - 4.0).abs() < 1e-9);
+        assert_eq!(left_wrist_speed(&wave[..1]), 0.0);
+    }
 
     #[test]
     fn an_upright_trunk_leans_zero_and_a_bent_one_its_angle() {

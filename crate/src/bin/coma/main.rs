@@ -374,6 +374,21 @@ struct TransformerArgs {
     text_model: PathBuf,
 }
 
+/// Options of the action probes (`coma probe bow`, `coma probe wave`).
+#[derive(clap::Args)]
+struct ActionArgs {
+    #[arg(long, default_value_t = 20)]
+    seeds: u64,
+    /// Guidance scales of the base transformer to try (repeat for a sweep).
+    #[arg(long, default_values_t = [coma::model::generate::SamplingOptions::default().base_guidance])]
+    guidance: Vec<f32>,
+    /// Dataset whose training motions of the action are the reference.
+    #[arg(long, default_value = "data/bandai")]
+    data: PathBuf,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
 #[derive(Subcommand)]
 enum ProbeCommand {
     /// Raise and wave each hand over many seeds: how often the asked wrist ends higher.
@@ -391,18 +406,10 @@ enum ProbeCommand {
         model: ModelArgs,
     },
     /// "A person bows" over many seeds: how far the trunk leans, against the dataset's bows.
-    Bow {
-        #[arg(long, default_value_t = 20)]
-        seeds: u64,
-        /// Guidance scales of the base transformer to try (repeat for a sweep).
-        #[arg(long, default_values_t = [coma::model::generate::SamplingOptions::default().base_guidance])]
-        guidance: Vec<f32>,
-        /// Dataset whose training bows are the reference.
-        #[arg(long, default_value = "data/bandai")]
-        data: PathBuf,
-        #[command(flatten)]
-        model: ModelArgs,
-    },
+    Bow(ActionArgs),
+    /// "A person waves the left hand" over many seeds: how fast the left wrist moves, against
+    /// the dataset's left-hand waves.
+    Wave(ActionArgs),
     /// Blend two segments: speeds at the join against real motion's 99th percentile.
     Continuity {
         /// Dataset whose test motions give the reference speeds.
@@ -457,13 +464,51 @@ enum ViewArg {
     ThreeQuarter,
 }
 
+/// Prints how much of an action the model performs over seeds and guidance scales, against
+/// the training motions that show it.
+fn action_probe(
+    generator: &coma::model::MotionModel,
+    probe: &coma::eval::probes::ActionProbe,
+    args: ActionArgs,
+) -> Result<()> {
+    use coma::eval::probes::{action, quantile, real_performances};
+    let set = coma::train::motions::MotionSet::load(&args.data, coma::dataset::Split::Train)?;
+    let real = real_performances(&set, probe);
+    anyhow::ensure!(
+        !real.is_empty(),
+        "no training motion of {} is labelled {:?}",
+        args.data.display(),
+        probe.content
+    );
+    let (name, unit) = (probe.measure_name, probe.unit);
+    let p10 = quantile(real.clone(), 0.1);
+    println!(
+        "real {} ({} training motions): {name} median {:.2}{unit}, 10th percentile {p10:.2}{unit}",
+        probe.content,
+        real.len(),
+        quantile(real, 0.5)
+    );
+    for r in action(generator, probe, args.seeds, 4.0, &args.guidance, p10) {
+        println!(
+            "\"{}\", guidance {}: {name} median {:.2}{unit} over {} seeds, {:.0} % reach {p10:.2}{unit}",
+            probe.prompt,
+            r.guidance,
+            quantile(r.values.clone(), 0.5),
+            r.values.len(),
+            r.reaching * 100.0
+        );
+    }
+    Ok(())
+}
+
 /// Runs a control probe and prints its figures.
 fn probe(command: ProbeCommand) -> Result<()> {
     use coma::eval::probes::{continuity, edit_locality, left_right};
     let models = match &command {
         ProbeCommand::Leftright { model, .. }
         | ProbeCommand::Locality { model, .. }
-        | ProbeCommand::Bow { model, .. }
+        | ProbeCommand::Bow(ActionArgs { model, .. })
+        | ProbeCommand::Wave(ActionArgs { model, .. })
         | ProbeCommand::Continuity { model, .. } => model.models.clone(),
     };
     let generator = load_model(&models)?;
@@ -491,49 +536,8 @@ fn probe(command: ProbeCommand) -> Result<()> {
                 r.left_wrist_rise_gain_cm
             );
         }
-        ProbeCommand::Bow {
-            seeds,
-            guidance,
-            data,
-            ..
-        } => {
-            use coma::eval::probes::{bow, quantile, trunk_lean};
-            let set = coma::train::motions::MotionSet::load(&data, coma::dataset::Split::Train)?;
-            let real: Vec<f64> = set
-                .items
-                .iter()
-                .filter(|i| {
-                    i.captions
-                        .iter()
-                        .any(|c| c.split_whitespace().any(|w| w.starts_with("bow")))
-                })
-                .map(|i| {
-                    trunk_lean(&coma::features::features_to_joints(
-                        &set.normalizer.denormalize(&i.features),
-                    ))
-                })
-                .collect();
-            anyhow::ensure!(
-                !real.is_empty(),
-                "no bows among the training motions of {}",
-                data.display()
-            );
-            let p10 = quantile(real.clone(), 0.1);
-            println!(
-                "real bows ({} training motions): trunk lean median {:.0}°, 10th percentile {p10:.0}°",
-                real.len(),
-                quantile(real, 0.5)
-            );
-            for r in bow(&generator, seeds, 4.0, &guidance, p10) {
-                println!(
-                    "\"a person bows\", guidance {}: trunk lean median {:.0}° over {} seeds, {:.0} % lean at least {p10:.0}°",
-                    r.guidance,
-                    quantile(r.leans.clone(), 0.5),
-                    r.leans.len(),
-                    r.bowing * 100.0
-                );
-            }
-        }
+        ProbeCommand::Bow(args) => action_probe(&generator, &coma::eval::probes::BOW, args)?,
+        ProbeCommand::Wave(args) => action_probe(&generator, &coma::eval::probes::LEFT_WAVE, args)?,
         ProbeCommand::Continuity { data, seed, .. } => {
             let set = coma::train::motions::MotionSet::load(&data, coma::dataset::Split::Test)?;
             let reference: Vec<_> = set
