@@ -8,7 +8,7 @@
 //!   do, "a person waves the left hand" must move that hand about as much as its waves do.
 
 use crate::executor::block_on;
-use crate::features::{features_to_joints, FeatureFrame, FPS, POSITIONS};
+use crate::features::{FeatureFrame, FPS, POSITIONS};
 use crate::geom::{self, Vec3};
 use crate::model::generate::SamplingOptions;
 use crate::model::motion_model::sampling;
@@ -305,11 +305,7 @@ pub fn real_performances(set: &MotionSet, probe: &ActionProbe) -> Vec<f64> {
     set.items
         .iter()
         .filter(|i| i.content.as_deref() == Some(probe.content))
-        .map(|i| {
-            (probe.measure)(&features_to_joints(
-                &set.normalizer.denormalize(&i.features),
-            ))
-        })
+        .map(|i| (probe.measure)(&set.joints(i)))
         .collect()
 }
 

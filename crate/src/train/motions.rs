@@ -5,7 +5,7 @@ use crate::dataset::Split;
 use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM};
 use crate::npy::NpyArray;
 use crate::rng::Rng;
-use crate::skeleton::BodyPart;
+use crate::skeleton::{BodyPart, Pose};
 use anyhow::{bail, Context, Result};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -64,6 +64,11 @@ pub struct CropBatch {
 }
 
 impl MotionSet {
+    /// The item's joint positions (metres, Y up, 20 fps), from its features.
+    pub fn joints(&self, item: &MotionItem) -> Vec<Pose> {
+        features::features_to_joints(&self.normalizer.denormalize(&item.features))
+    }
+
     /// Reads the items listed in `<dir>/<split>.txt`.
     pub fn load(dir: &Path, split: Split) -> Result<MotionSet> {
         let normalizer = Normalizer::read(dir.join("Mean.npy"), dir.join("Std.npy"))

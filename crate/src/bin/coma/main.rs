@@ -540,13 +540,7 @@ fn probe(command: ProbeCommand) -> Result<()> {
         ProbeCommand::Wave(args) => action_probe(&generator, &coma::eval::probes::LEFT_WAVE, args)?,
         ProbeCommand::Continuity { data, seed, .. } => {
             let set = coma::train::motions::MotionSet::load(&data, coma::dataset::Split::Test)?;
-            let reference: Vec<_> = set
-                .items
-                .iter()
-                .map(|i| {
-                    coma::features::features_to_joints(&set.normalizer.denormalize(&i.features))
-                })
-                .collect();
+            let reference: Vec<_> = set.items.iter().map(|i| set.joints(i)).collect();
             let r = continuity(
                 &generator,
                 "a person walks forward",
@@ -977,11 +971,7 @@ fn evaluate(
         );
         probes.edit_leg_change_cm = Some(locality.leg_change_cm);
         probes.edit_left_wrist_gain_cm = Some(locality.left_wrist_rise_gain_cm);
-        let reference: Vec<_> = test
-            .items
-            .iter()
-            .map(|i| coma::features::features_to_joints(&test.normalizer.denormalize(&i.features)))
-            .collect();
+        let reference: Vec<_> = test.items.iter().map(|i| test.joints(i)).collect();
         let join = continuity(
             generator,
             "a person walks forward",
