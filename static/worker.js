@@ -5,13 +5,20 @@ import init, { worker_main } from "../pkg/coma_web.js";
 
 self.addEventListener(
   "message",
-  async (event) => {
+  (event) => {
     const module_or_path =
       event.data instanceof WebAssembly.Module
         ? event.data
         : new URL("../pkg/coma_web_bg.wasm", import.meta.url);
-    await init({ module_or_path });
-    worker_main();
+    init({ module_or_path })
+      .then(() => worker_main())
+      .catch((err) => {
+        // A rejected promise would not reach the page's onerror; a thrown error does, and
+        // the page then says the worker stopped instead of waiting for it forever.
+        setTimeout(() => {
+          throw err;
+        });
+      });
   },
   { once: true },
 );

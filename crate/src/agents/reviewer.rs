@@ -366,11 +366,20 @@ mod tests {
         }
     }
 
-    fn judge(reply: ScriptedReply) -> (Review, ScriptServer) {
-        let server = ScriptServer::start([reply]).unwrap();
+    /// A client of `server` for the model "judge", with `vision_model` if given, no retries.
+    fn client(
+        server: &ScriptServer,
+        vision_model: Option<&str>,
+    ) -> LlmClient<crate::agents::llm::UreqTransport> {
         let mut config = LlmConfig::new(server.base_url(), "judge");
         config.max_retries = 0;
-        let client = LlmClient::native(config).unwrap();
+        config.vision_model = vision_model.map(str::to_string);
+        LlmClient::native(config).unwrap()
+    }
+
+    fn judge(reply: ScriptedReply) -> (Review, ScriptServer) {
+        let server = ScriptServer::start([reply]).unwrap();
+        let client = client(&server, None);
         (
             block_on(judge_llm(&client, &segment(), offline_review())),
             server,
@@ -434,13 +443,6 @@ mod tests {
         }
     }
 
-    fn vision_client(server: &ScriptServer) -> LlmClient<crate::agents::llm::UreqTransport> {
-        let mut config = LlmConfig::new(server.base_url(), "judge");
-        config.max_retries = 0;
-        config.vision_model = Some("eyes".into());
-        LlmClient::native(config).unwrap()
-    }
-
     fn walking_poses() -> Vec<Pose> {
         let mut pose = [[0.0; 3]; crate::skeleton::NUM_JOINTS];
         for (j, p) in pose.iter_mut().enumerate() {
@@ -457,22 +459,35 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn a_vision_model_looks_before_the_judge_reads() {
-        let server = ScriptServer::start([
-            ScriptedReply::completion("The figure strides forward, its left arm swinging high."),
-            ScriptedReply::completion(
-                r#"{"left_arm": null, "right_arm": null, "lower_body": null}"#,
-            ),
-        ])
-        .unwrap();
-        let client = vision_client(&server);
+    /// The LLM review of a walking segment by a server replaying `replies`.
+    fn review_with(
+        replies: impl IntoIterator<Item = ScriptedReply>,
+        vision_model: Option<&str>,
+    ) -> (Review, ScriptServer) {
+        let server = ScriptServer::start(replies).unwrap();
+        let client = client(&server, vision_model);
         let review = block_on(review_llm(
             &client,
             &segment(),
             &walking_poses(),
             offline_review(),
         ));
+        (review, server)
+    }
+
+    #[test]
+    fn a_vision_model_looks_before_the_judge_reads() {
+        let (review, server) = review_with(
+            [
+                ScriptedReply::completion(
+                    "The figure strides forward, its left arm swinging high.",
+                ),
+                ScriptedReply::completion(
+                    r#"{"left_arm": null, "right_arm": null, "lower_body": null}"#,
+                ),
+            ],
+            Some("eyes"),
+        );
         assert_eq!(review.note, None);
         assert!(review.corrections.is_empty());
         assert!(review.description.starts_with("A person walks forward."));
@@ -491,20 +506,15 @@ mod tests {
 
     #[test]
     fn a_failing_vision_model_leaves_the_pose_codes_to_the_judge() {
-        let server = ScriptServer::start([
-            ScriptedReply::error(500, "no eyes today"),
-            ScriptedReply::completion(
-                r#"{"left_arm": "a person waves the left hand", "right_arm": null, "lower_body": null}"#,
-            ),
-        ])
-        .unwrap();
-        let client = vision_client(&server);
-        let review = block_on(review_llm(
-            &client,
-            &segment(),
-            &walking_poses(),
-            offline_review(),
-        ));
+        let (review, _) = review_with(
+            [
+                ScriptedReply::error(500, "no eyes today"),
+                ScriptedReply::completion(
+                    r#"{"left_arm": "a person waves the left hand", "right_arm": null, "lower_body": null}"#,
+                ),
+            ],
+            Some("eyes"),
+        );
         let note = review.note.unwrap_or_default();
         assert!(note.contains("vision describer failed"), "{note}");
         assert_eq!(review.description, offline_review().description);
@@ -519,19 +529,12 @@ mod tests {
 
     #[test]
     fn without_a_vision_model_nothing_is_shown_a_picture() {
-        let server = ScriptServer::start([ScriptedReply::completion(
-            r#"{"left_arm": null, "right_arm": null, "lower_body": null}"#,
-        )])
-        .unwrap();
-        let mut config = LlmConfig::new(server.base_url(), "judge");
-        config.max_retries = 0;
-        let client = LlmClient::native(config).unwrap();
-        block_on(review_llm(
-            &client,
-            &segment(),
-            &walking_poses(),
-            offline_review(),
-        ));
+        let (_, server) = review_with(
+            [ScriptedReply::completion(
+                r#"{"left_arm": null, "right_arm": null, "lower_body": null}"#,
+            )],
+            None,
+        );
         let requests = server.requests();
         assert_eq!(requests.len(), 1);
         assert!(!requests[0].json().to_string().contains("image_url"));
