@@ -83,25 +83,62 @@ pub fn left_right(model: &MotionModel, seeds: u64, seconds: f64) -> LeftRightRep
     }
 }
 
-/// Result of the edit-locality probe.
+/// The motion the edit-locality probe edits.
+pub const LOCALITY_BASE: &str = "a person walks forward";
+/// The left arm's new instruction in the edit-locality probe.
+pub const LOCALITY_EDIT: &str = "the person waves the left hand above the head";
+/// Seeds the edit-locality probe averages over by default (0..5): one seed's figure varies
+/// by about half a centimetre.
+pub const LOCALITY_SEEDS: u64 = 5;
+
+/// Result of the edit-locality probe, averaged over its seeds.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct LocalityReport {
     /// Mean displacement of the leg joints between the original and the edited motion, cm.
     pub leg_change_cm: f64,
     /// How much higher the left wrist rises after the edit than before, cm.
     pub left_wrist_rise_gain_cm: f64,
+    /// Both figures for each seed, in seed order.
+    pub per_seed: Vec<LocalitySample>,
 }
 
-/// Generates `base` (a walk), edits the left arm with `instruction`, and measures how much the
-/// legs moved and what the arm did. The legs are compared in the body's own frame (the
-/// features' joint positions: relative to the root, facing +Z), so a changed path or heading
-/// does not count as a leg change.
+/// The edit-locality figures of one seed.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct LocalitySample {
+    pub seed: u64,
+    pub leg_change_cm: f64,
+    pub left_wrist_rise_gain_cm: f64,
+}
+
+/// For each seed, generates `base` (a walk), edits the left arm with `instruction`, and
+/// measures how much the legs moved and what the arm did. The legs are compared in the body's
+/// own frame (the features' joint positions: relative to the root, facing +Z), so a changed
+/// path or heading does not count as a leg change.
 pub fn edit_locality(
     model: &MotionModel,
     base: &str,
     instruction: &str,
-    seed: u64,
+    seeds: std::ops::Range<u64>,
 ) -> LocalityReport {
+    let per_seed: Vec<LocalitySample> = seeds
+        .map(|seed| edit_locality_sample(model, base, instruction, seed))
+        .collect();
+    let mean = |f: fn(&LocalitySample) -> f64| {
+        per_seed.iter().map(f).sum::<f64>() / per_seed.len().max(1) as f64
+    };
+    LocalityReport {
+        leg_change_cm: mean(|s| s.leg_change_cm),
+        left_wrist_rise_gain_cm: mean(|s| s.left_wrist_rise_gain_cm),
+        per_seed,
+    }
+}
+
+fn edit_locality_sample(
+    model: &MotionModel,
+    base: &str,
+    instruction: &str,
+    seed: u64,
+) -> LocalitySample {
     let original = block_on(model.generate(base, &[], 120, seed));
     let edited =
         block_on(model.edit_parts(&original, instruction, &[BodyPart::LeftArm], base, seed + 1));
@@ -135,7 +172,8 @@ pub fn edit_locality(
         block_on(model.joints(&original)),
         block_on(model.joints(&edited)),
     );
-    LocalityReport {
+    LocalitySample {
+        seed,
         leg_change_cm: total / count.max(1) as f64 * 100.0,
         left_wrist_rise_gain_cm: (wrist_rise(&b, joint::L_WRIST) - wrist_rise(&a, joint::L_WRIST))
             * 100.0,
@@ -320,13 +358,14 @@ pub struct ActionReport {
 }
 
 /// Generates the probe's prompt (`seconds` long) with each seed at each guidance scale of the
-/// base transformer, and measures each motion against `real_p10`, the 10th percentile of
-/// [`real_performances`].
+/// base transformer (the other sampling options from `options`, whose seed is replaced), and
+/// measures each motion against `real_p10`, the 10th percentile of [`real_performances`].
 pub fn action(
     model: &MotionModel,
     probe: &ActionProbe,
     seeds: u64,
     seconds: f64,
+    options: &SamplingOptions,
     guidance: &[f32],
     real_p10: f64,
 ) -> Vec<ActionReport> {
@@ -338,7 +377,8 @@ pub fn action(
                 .map(|seed| {
                     let options = SamplingOptions {
                         base_guidance: g,
-                        ..sampling(seed)
+                        seed,
+                        ..options.clone()
                     };
                     block_on(async {
                         let tokens = model

@@ -135,12 +135,14 @@ impl EvalReport {
         }
         if let Some(cm) = p.edit_leg_change_cm {
             md.push_str(&format!(
-                "| left-arm edit of a walk: mean leg-joint change | {cm:.2} cm |\n"
+                "| left-arm edit of a walk, seeds 0–{}: mean leg-joint change | {cm:.2} cm |\n",
+                super::probes::LOCALITY_SEEDS - 1
             ));
         }
         if let Some(cm) = p.edit_left_wrist_gain_cm {
             md.push_str(&format!(
-                "| left-arm edit of a walk: extra left-wrist rise | {cm:.1} cm |\n"
+                "| left-arm edit of a walk, seeds 0–{}: extra left-wrist rise | {cm:.1} cm |\n",
+                super::probes::LOCALITY_SEEDS - 1
             ));
         }
         if let Some(j) = p.join_speeds {

@@ -3,8 +3,9 @@
 //!
 //! - generate: everything masked;
 //! - in-between: the steps covering frames α..β masked in all parts;
-//! - body part: every step of the chosen parts masked, plus a few random tokens of the others
-//!   so the joins stay natural;
+//! - body part: every step of the chosen parts masked, the other parts' tokens kept (the
+//!   transformers see them, so the new part fits the rest; the decoder is shared, so the
+//!   kept parts still move a little: `coma probe locality` measures it);
 //! - blend: two motions joined with a masked transition between the end of one and the start
 //!   of the next.
 
@@ -32,9 +33,6 @@ pub fn part_text(global: &[f32; TEXT_DIM], overrides: &[(BodyPart, [f32; TEXT_DI
     })
 }
 
-/// Fraction of the other parts' tokens re-generated in a body-part edit.
-pub const PART_EDIT_CONTEXT: f32 = 0.1;
-
 /// Time steps (of 4 frames) needed for `frames` frames, within the model's range.
 pub fn steps_for_frames(frames: usize, max_steps: usize) -> usize {
     (frames.div_ceil(DOWNSAMPLE)).clamp(1, max_steps)
@@ -45,6 +43,7 @@ impl Spam {
     async fn fill(
         &self,
         text: &PartText,
+        away: Option<&PartText>,
         original: Option<&MotionTokens>,
         editable: &[Vec<bool>],
         options: &SamplingOptions,
@@ -66,9 +65,11 @@ impl Spam {
                     .collect()
             })
             .collect();
-        let base = self.decode_base(text, &fixed, options, &mut rng).await;
+        let base = self
+            .decode_base(text, away, &fixed, options, &mut rng)
+            .await;
         let keep = original.map(|tokens| KeepResidual { tokens, editable });
-        self.decode_residual(text, base, keep, options, &mut rng)
+        self.decode_residual(text, away, base, keep, options, &mut rng)
             .await
     }
 
@@ -80,7 +81,7 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = steps_for_frames(frames, self.base_config.max_steps - 1);
-        self.fill(text, None, &vec![vec![true; n]; PARTS], options)
+        self.fill(text, None, None, &vec![vec![true; n]; PARTS], options)
             .await
     }
 
@@ -98,10 +99,13 @@ impl Spam {
         let editable: Vec<Vec<bool>> = (0..PARTS)
             .map(|_| (0..n).map(|s| s >= a && s < b).collect())
             .collect();
-        self.fill(text, Some(tokens), &editable, options).await
+        self.fill(text, None, Some(tokens), &editable, options)
+            .await
     }
 
-    /// Regenerates the chosen parts from their new text (other parts keep their text).
+    /// Regenerates the chosen parts from their new text; the other parts keep their tokens.
+    /// (Re-generating a tenth of the other parts' tokens as well, tried before, moved the legs
+    /// of an arm-edited walk more and did not make the arm follow its text better.)
     pub async fn edit_parts(
         &self,
         tokens: &MotionTokens,
@@ -110,17 +114,24 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = tokens[0][0].len();
-        let mut rng = Rng::new(options.seed ^ 0x5EED);
         let editable: Vec<Vec<bool>> = BodyPart::ALL
             .iter()
-            .map(|p| {
-                let chosen = parts.contains(p);
-                (0..n)
-                    .map(|_| chosen || rng.uniform() < PART_EDIT_CONTEXT)
-                    .collect()
-            })
+            .map(|p| vec![parts.contains(p); n])
             .collect();
-        self.fill(text, Some(tokens), &editable, options).await
+        // Guidance steers the edited parts away from what the rest of the body's text would
+        // make them do, rather than away from no text at all.
+        let rest = BodyPart::ALL.iter().position(|p| !parts.contains(p));
+        let away: Option<PartText> = rest.map(|r| {
+            std::array::from_fn(|p| {
+                if parts.contains(&BodyPart::ALL[p]) {
+                    text[r]
+                } else {
+                    text[p]
+                }
+            })
+        });
+        self.fill(text, away.as_ref(), Some(tokens), &editable, options)
+            .await
     }
 
     /// Joins `a` then `b`: the last `overlap` steps of `a` and the first `overlap` of `b` are
@@ -166,7 +177,9 @@ impl Spam {
             v.iter_mut().for_each(|x| *x /= norm);
             v
         });
-        let window = self.fill(&text, Some(&joined), &editable, options).await;
+        let window = self
+            .fill(&text, None, Some(&joined), &editable, options)
+            .await;
         (0..PARTS)
             .map(|p| {
                 (0..layers)
@@ -260,7 +273,7 @@ mod tests {
     }
 
     #[test]
-    fn part_edit_mostly_keeps_the_other_parts() {
+    fn part_edit_keeps_the_other_parts() {
         block_on(async {
             let s = spam();
             let text = [[0.05f32; TEXT_DIM]; PARTS];
@@ -268,14 +281,12 @@ mod tests {
             let edited = s
                 .edit_parts(&original, &text, &[BodyPart::LeftArm], &seeded(3))
                 .await;
-            let n = original[0][0].len();
-            let same = (0..n)
-                .filter(|&i| original[3][0][i] == edited[3][0][i])
-                .count();
-            assert!(
-                same as f32 >= 0.75 * n as f32,
-                "right leg kept {same} of {n} base tokens"
+            assert_eq!(
+                original[1..],
+                edited[1..],
+                "right arm and legs keep every token"
             );
+            assert_ne!(original[0], edited[0], "the left arm is generated again");
         })
     }
 

@@ -379,9 +379,18 @@ struct TransformerArgs {
 struct ActionArgs {
     #[arg(long, default_value_t = 20)]
     seeds: u64,
+    /// Length of each generated motion in seconds.
+    #[arg(long, default_value_t = 4.0)]
+    seconds: f64,
     /// Guidance scales of the base transformer to try (repeat for a sweep).
     #[arg(long, default_values_t = [coma::model::generate::SamplingOptions::default().base_guidance])]
     guidance: Vec<f32>,
+    /// Sample each code only among the K most likely (default: all).
+    #[arg(long)]
+    top_k: Option<usize>,
+    /// Softmax temperature of the sampling (0 takes the most likely code).
+    #[arg(long, default_value_t = coma::model::generate::SamplingOptions::default().temperature)]
+    temperature: f32,
     /// Dataset whose training motions of the action are the reference.
     #[arg(long, default_value = "data/bandai")]
     data: PathBuf,
@@ -398,10 +407,10 @@ enum ProbeCommand {
         #[command(flatten)]
         model: ModelArgs,
     },
-    /// Edit the left arm of a walk: how much the legs move, what the arm does.
+    /// Edit the left arm of a walk: how much the legs move, what the arm does (seeds 0..N).
     Locality {
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
+        #[arg(long, default_value_t = coma::eval::probes::LOCALITY_SEEDS)]
+        seeds: u64,
         #[command(flatten)]
         model: ModelArgs,
     },
@@ -488,10 +497,33 @@ fn action_probe(
         real.len(),
         quantile(real, 0.5)
     );
-    for r in action(generator, probe, args.seeds, 4.0, &args.guidance, p10) {
+    let options = coma::model::generate::SamplingOptions {
+        top_k: args.top_k,
+        temperature: args.temperature,
+        ..Default::default()
+    };
+    let sampling = match args.top_k {
+        Some(k) => format!(", top-k {k}, temperature {}", args.temperature),
+        None => format!(", temperature {}", args.temperature),
+    };
+    anyhow::ensure!(
+        args.seconds > 0.0 && args.seconds.is_finite(),
+        "--seconds must be a positive number, not {}",
+        args.seconds
+    );
+    for r in action(
+        generator,
+        probe,
+        args.seeds,
+        args.seconds,
+        &options,
+        &args.guidance,
+        p10,
+    ) {
         println!(
-            "\"{}\", guidance {}: {name} median {:.2}{unit} over {} seeds, {:.0} % reach {p10:.2}{unit}",
+            "\"{}\", {} s, guidance {}{sampling}: {name} median {:.2}{unit} over {} seeds, {:.0} % reach {p10:.2}{unit}",
             probe.prompt,
+            args.seconds,
             r.guidance,
             quantile(r.values.clone(), 0.5),
             r.values.len(),
@@ -503,7 +535,7 @@ fn action_probe(
 
 /// Runs a control probe and prints its figures.
 fn probe(command: ProbeCommand) -> Result<()> {
-    use coma::eval::probes::{continuity, edit_locality, left_right};
+    use coma::eval::probes::{continuity, edit_locality, left_right, LOCALITY_BASE, LOCALITY_EDIT};
     let models = match &command {
         ProbeCommand::Leftright { model, .. }
         | ProbeCommand::Locality { model, .. }
@@ -520,19 +552,20 @@ fn probe(command: ProbeCommand) -> Result<()> {
             }
             println!("left/right correct: {:.1} %", report.rate * 100.0);
         }
-        ProbeCommand::Locality { seed, .. } => {
-            let r = edit_locality(
-                &generator,
-                "a person walks forward",
-                "the person waves the left hand above the head",
-                seed,
-            );
+        ProbeCommand::Locality { seeds, .. } => {
+            let r = edit_locality(&generator, LOCALITY_BASE, LOCALITY_EDIT, 0..seeds);
+            for s in &r.per_seed {
+                println!(
+                    "seed {}: legs {:.2} cm, left wrist {:+.1} cm",
+                    s.seed, s.leg_change_cm, s.left_wrist_rise_gain_cm
+                );
+            }
             println!(
-                "mean leg-joint change after a left-arm edit: {:.2} cm",
+                "mean leg-joint change after a left-arm edit over {seeds} seeds: {:.2} cm",
                 r.leg_change_cm
             );
             println!(
-                "left wrist rises {:.1} cm more after the edit",
+                "left wrist rises {:.1} cm more after the edit (mean)",
                 r.left_wrist_rise_gain_cm
             );
         }
@@ -958,17 +991,14 @@ fn evaluate(
     let rows = protocol.run(&sources, options, &|l| eprintln!("{l}"))?;
     let mut probes = Probes::default();
     if let Some(generator) = &spam {
-        use coma::eval::probes::{continuity, edit_locality, left_right};
+        use coma::eval::probes::{
+            continuity, edit_locality, left_right, LOCALITY_BASE, LOCALITY_EDIT, LOCALITY_SEEDS,
+        };
         eprintln!("probes: left/right over {probe_seeds} seeds a prompt");
         let lr = left_right(generator, probe_seeds, 4.0);
         probes.left_right_rate = Some(lr.rate);
         probes.left_right = lr.prompts;
-        let locality = edit_locality(
-            generator,
-            "a person walks forward",
-            "the person waves the left hand above the head",
-            0,
-        );
+        let locality = edit_locality(generator, LOCALITY_BASE, LOCALITY_EDIT, 0..LOCALITY_SEEDS);
         probes.edit_leg_change_cm = Some(locality.leg_change_cm);
         probes.edit_left_wrist_gain_cm = Some(locality.left_wrist_rise_gain_cm);
         let reference: Vec<_> = test.items.iter().map(|i| test.joints(i)).collect();
