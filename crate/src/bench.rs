@@ -83,15 +83,14 @@ pub fn run_bench(
     let n = 49;
     let fixed = vec![vec![None; n]; PARTS];
     let (base, t) =
-        seconds_of(|| block_on(spam.decode_base(&condition, None, &fixed, &options, &mut rng)));
+        seconds_of(|| block_on(spam.decode_base(&condition, &fixed, &options, &mut rng)));
     rows.push(row(
         "base tokens, 196 frames (10 iterations)",
         t * 1e3,
         "ms",
     ));
-    let (tokens, t) = seconds_of(|| {
-        block_on(spam.decode_residual(&condition, None, base, None, &options, &mut rng))
-    });
+    let (tokens, t) =
+        seconds_of(|| block_on(spam.decode_residual(&condition, base, None, &options, &mut rng)));
     if spam.residual.is_some() {
         rows.push(row("residual tokens, 196 frames", t * 1e3, "ms"));
     }

@@ -3,9 +3,9 @@
 //!
 //! - generate: everything masked;
 //! - in-between: the steps covering frames α..β masked in all parts;
-//! - body part: every step of the chosen parts masked, the other parts' tokens kept (the
-//!   transformers see them, so the new part fits the rest; the decoder is shared, so the
-//!   kept parts still move a little: `coma probe locality` measures it);
+//! - body part: the chosen parts' tokens replaced by those of a motion generated from their
+//!   text, the other parts' tokens kept (the decoder is shared, so the kept parts still move
+//!   a little: `coma probe locality` measures it);
 //! - blend: two motions joined with a masked transition between the end of one and the start
 //!   of the next.
 
@@ -43,7 +43,6 @@ impl Spam {
     async fn fill(
         &self,
         text: &PartText,
-        away: Option<&PartText>,
         original: Option<&MotionTokens>,
         editable: &[Vec<bool>],
         options: &SamplingOptions,
@@ -65,11 +64,9 @@ impl Spam {
                     .collect()
             })
             .collect();
-        let base = self
-            .decode_base(text, away, &fixed, options, &mut rng)
-            .await;
+        let base = self.decode_base(text, &fixed, options, &mut rng).await;
         let keep = original.map(|tokens| KeepResidual { tokens, editable });
-        self.decode_residual(text, away, base, keep, options, &mut rng)
+        self.decode_residual(text, base, keep, options, &mut rng)
             .await
     }
 
@@ -81,7 +78,7 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = steps_for_frames(frames, self.base_config.max_steps - 1);
-        self.fill(text, None, None, &vec![vec![true; n]; PARTS], options)
+        self.fill(text, None, &vec![vec![true; n]; PARTS], options)
             .await
     }
 
@@ -99,13 +96,14 @@ impl Spam {
         let editable: Vec<Vec<bool>> = (0..PARTS)
             .map(|_| (0..n).map(|s| s >= a && s < b).collect())
             .collect();
-        self.fill(text, None, Some(tokens), &editable, options)
-            .await
+        self.fill(text, Some(tokens), &editable, options).await
     }
 
-    /// Regenerates the chosen parts from their new text; the other parts keep their tokens.
-    /// (Re-generating a tenth of the other parts' tokens as well, tried before, moved the legs
-    /// of an arm-edited walk more and did not make the arm follow its text better.)
+    /// Gives the chosen parts new tokens from their text; the other parts keep theirs. The
+    /// new tokens come from a motion generated with the whole body following the chosen parts'
+    /// text, and are moved onto this one: the dataset has few motions that, say, walk and wave
+    /// at once, so a part regenerated beside the walking legs tends to move as in a walk,
+    /// whereas the shared decoder turns a waving arm's tokens beside walking legs into both.
     pub async fn edit_parts(
         &self,
         tokens: &MotionTokens,
@@ -114,24 +112,27 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = tokens[0][0].len();
-        let editable: Vec<Vec<bool>> = BodyPart::ALL
-            .iter()
-            .map(|p| vec![parts.contains(p); n])
+        let chosen: Vec<usize> = (0..PARTS)
+            .filter(|p| parts.contains(&BodyPart::ALL[*p]))
             .collect();
-        // Guidance steers the edited parts away from what the rest of the body's text would
-        // make them do, rather than away from no text at all.
-        let rest = BodyPart::ALL.iter().position(|p| !parts.contains(p));
-        let away: Option<PartText> = rest.map(|r| {
-            std::array::from_fn(|p| {
-                if parts.contains(&BodyPart::ALL[p]) {
-                    text[r]
-                } else {
-                    text[p]
-                }
-            })
+        let Some(&first) = chosen.first() else {
+            return tokens.clone();
+        };
+        let donor_text: PartText = std::array::from_fn(|p| {
+            if chosen.contains(&p) {
+                text[p]
+            } else {
+                text[first]
+            }
         });
-        self.fill(text, away.as_ref(), Some(tokens), &editable, options)
-            .await
+        let donor = self
+            .fill(&donor_text, None, &vec![vec![true; n]; PARTS], options)
+            .await;
+        let mut edited = tokens.clone();
+        for p in chosen {
+            edited[p] = donor[p].clone();
+        }
+        edited
     }
 
     /// Joins `a` then `b`: the last `overlap` steps of `a` and the first `overlap` of `b` are
@@ -177,9 +178,7 @@ impl Spam {
             v.iter_mut().for_each(|x| *x /= norm);
             v
         });
-        let window = self
-            .fill(&text, None, Some(&joined), &editable, options)
-            .await;
+        let window = self.fill(&text, Some(&joined), &editable, options).await;
         (0..PARTS)
             .map(|p| {
                 (0..layers)
@@ -273,7 +272,7 @@ mod tests {
     }
 
     #[test]
-    fn part_edit_keeps_the_other_parts() {
+    fn part_edit_moves_the_instruction_s_part_onto_the_motion() {
         block_on(async {
             let s = spam();
             let text = [[0.05f32; TEXT_DIM]; PARTS];
@@ -287,6 +286,11 @@ mod tests {
                 "right arm and legs keep every token"
             );
             assert_ne!(original[0], edited[0], "the left arm is generated again");
+            let donor = s.generate(&text, 160, &seeded(3)).await;
+            assert_eq!(
+                edited[0], donor[0],
+                "the left arm of the instruction's own motion"
+            );
         })
     }
 

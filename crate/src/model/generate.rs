@@ -13,8 +13,7 @@ use burn::tensor::{Bool, Int, TensorData};
 pub struct SamplingOptions {
     /// Unmasking iterations of the base layer.
     pub iterations: usize,
-    /// Guidance scale `s` of the base transformer: logits = (1 + s)·cond − s·uncond, where
-    /// uncond has no text (or, in a body-part edit, the rest of the body's text).
+    /// Guidance scale `s` of the base transformer: logits = (1 + s)·cond − s·uncond.
     pub base_guidance: f32,
     /// Guidance scale of the residual transformer.
     pub residual_guidance: f32,
@@ -108,23 +107,18 @@ async fn guided(logits: Tensor<4>, scale: f32) -> Vec<f32> {
         .collect()
 }
 
-/// Inputs shared by every call: text `[2, 4, 384]`, the condition first, then what guidance
-/// steers away from: no text at all (keep `[2, 4]` = (1, 0)), or `away` when given (keep
-/// (1, 1)); and no padding.
+/// Inputs shared by every call: text `[2, 4, 384]` (same text twice) with keep `[2, 4]`
+/// = (1, 0), and no padding.
 fn conditions(
     text: &[[f32; TEXT_DIM]; PARTS],
-    away: Option<&[[f32; TEXT_DIM]; PARTS]>,
     n: usize,
     device: &Device,
 ) -> (Tensor<3>, Tensor<2>, Tensor<2, Bool>) {
-    let row = |t: &[[f32; TEXT_DIM]; PARTS]| {
-        let flat: Vec<f32> = t.iter().flatten().copied().collect();
-        Tensor::<3>::from_data(TensorData::new(flat, [1, PARTS, TEXT_DIM]), device)
-    };
-    let text = Tensor::cat(vec![row(text), row(away.unwrap_or(text))], 0);
-    let second = if away.is_some() { 1.0 } else { 0.0 };
+    let flat: Vec<f32> = text.iter().flatten().copied().collect();
+    let one = Tensor::<3>::from_data(TensorData::new(flat, [1, PARTS, TEXT_DIM]), device);
+    let text = Tensor::cat(vec![one.clone(), one], 0);
     let keep = Tensor::<2>::from_data(
-        TensorData::new([[1.0f32; PARTS], [second; PARTS]].concat(), [2, PARTS]),
+        TensorData::new([[1.0f32; PARTS], [0.0; PARTS]].concat(), [2, PARTS]),
         device,
     );
     let pad = Tensor::<2, Int>::zeros([2, n], device).equal_elem(1);
@@ -133,12 +127,10 @@ fn conditions(
 
 impl Spam {
     /// Fills the masked layer-0 tokens by iterative unmasking. `fixed[p][n]` holds tokens that
-    /// must stay (editing); `None` everywhere generates from scratch. Guidance steers from
-    /// `away` towards `text` (`None`: from no text at all). Returns `[part][step]`.
+    /// must stay (editing); `None` everywhere generates from scratch. Returns `[part][step]`.
     pub async fn decode_base(
         &self,
         text: &[[f32; TEXT_DIM]; PARTS],
-        away: Option<&[[f32; TEXT_DIM]; PARTS]>,
         fixed: &[Vec<Option<u32>>],
         options: &SamplingOptions,
         rng: &mut Rng,
@@ -147,7 +139,7 @@ impl Spam {
         let n = fixed[0].len();
         let k = config.codebook_size;
         let mask = config.mask_id() as u32;
-        let (text_t, keep, pad) = conditions(text, away, n, device);
+        let (text_t, keep, pad) = conditions(text, n, device);
         let mut ids: Vec<u32> = fixed
             .iter()
             .flat_map(|p| p.iter().map(|t| t.unwrap_or(mask)))
@@ -187,14 +179,12 @@ impl Spam {
         ids.chunks(n).map(|c| c.to_vec()).collect()
     }
 
-    /// Predicts residual layers `1..layers` from layer 0 (`[part][step]`), guided as
-    /// [`Spam::decode_base`]; positions that `keep` marks as not editable take the original
-    /// tokens. Returns `[part][layer][step]`, with
+    /// Predicts residual layers `1..layers` from layer 0 (`[part][step]`); positions that `keep`
+    /// marks as not editable take the original tokens. Returns `[part][layer][step]`, with
     /// layer 0 alone for a base-only model.
     pub async fn decode_residual(
         &self,
         text: &[[f32; TEXT_DIM]; PARTS],
-        away: Option<&[[f32; TEXT_DIM]; PARTS]>,
         base: Vec<Vec<u32>>,
         keep: Option<KeepResidual<'_>>,
         options: &SamplingOptions,
@@ -211,7 +201,7 @@ impl Spam {
         let device = &self.device;
         let n = layers[0][0].len();
         let k = config.codebook_size;
-        let (text_t, keep_text, pad) = conditions(text, away, n, device);
+        let (text_t, keep_text, pad) = conditions(text, n, device);
         for j in 1..config.vq_layers {
             let mut flat = Vec::with_capacity(2 * PARTS * j * n);
             for _ in 0..2 {
@@ -319,8 +309,8 @@ pub(crate) mod tests {
                 ..Default::default()
             };
             let mut rng = Rng::new(seed);
-            let b = block_on(spam.decode_base(&text, None, &fixed, &options, &mut rng));
-            block_on(spam.decode_residual(&text, None, b, None, &options, &mut rng))
+            let b = block_on(spam.decode_base(&text, &fixed, &options, &mut rng));
+            block_on(spam.decode_residual(&text, b, None, &options, &mut rng))
         };
         let a = run(5);
         assert_eq!(a, run(5));
@@ -342,15 +332,8 @@ pub(crate) mod tests {
         let text = [[0.1f32; TEXT_DIM]; PARTS];
         let options = SamplingOptions::default();
         let mut rng = Rng::new(1);
-        let b = block_on(spam.decode_base(
-            &text,
-            None,
-            &vec![vec![None; 6]; PARTS],
-            &options,
-            &mut rng,
-        ));
-        let tokens =
-            block_on(spam.decode_residual(&text, None, b.clone(), None, &options, &mut rng));
+        let b = block_on(spam.decode_base(&text, &vec![vec![None; 6]; PARTS], &options, &mut rng));
+        let tokens = block_on(spam.decode_residual(&text, b.clone(), None, &options, &mut rng));
         assert_eq!(tokens.len(), PARTS);
         for (part, base) in tokens.iter().zip(&b) {
             assert_eq!(part, &vec![base.clone()], "one layer, the base tokens");
