@@ -45,23 +45,6 @@ pub struct BatchDraw<'a> {
     pub drop_text: f32,
     /// Relative draw weight of every item (see [`TokenSet::draw_weights`]); `None` is uniform.
     pub weights: Option<&'a [f64]>,
-    /// Probability that a motion's arm is replaced by the same arm of another motion (see
-    /// [`TokenSet::batch`]).
-    pub splice: f32,
-}
-
-/// The parts a splice may replace: the arms, whose tokens also carry the torso.
-const SPLICED_PARTS: [usize; 2] = [0, 1];
-
-/// The arm a motion of a batch borrows from another (see [`TokenSet::batch`]).
-struct Donor<'a> {
-    item: &'a TokenItem,
-    /// Model part index of the arm.
-    part: usize,
-    /// First step of the borrowed window.
-    offset: usize,
-    /// Index of the arm's text in [`TokenSet::texts`].
-    text: usize,
 }
 
 /// A batch for the transformers: inputs, targets and conditions.
@@ -128,37 +111,6 @@ impl TokenSet {
         })
     }
 
-    /// An arm of a motion of at least `len` steps, drawn by `draw`, to splice into a motion of
-    /// `len` steps: which arm, where its window starts and the text it is conditioned on (its
-    /// own sentence when it has one, else or as often one of its captions). `None` after a few
-    /// draws with no motion long enough.
-    fn splice_donor<'s>(
-        &'s self,
-        len: usize,
-        rng: &mut Rng,
-        draw: &dyn Fn(&mut Rng) -> usize,
-    ) -> Option<Donor<'s>> {
-        let part = SPLICED_PARTS[rng.below(SPLICED_PARTS.len())];
-        (0..20).find_map(|_| {
-            let item = &self.items[draw(rng)];
-            let donor_len = item.tokens[0][0].len();
-            if donor_len < len || item.captions.is_empty() {
-                return None;
-            }
-            let caption = item.captions[rng.below(item.captions.len())];
-            let text = match item.parts[part] {
-                Some(own) if rng.uniform() < 0.5 => own,
-                _ => caption,
-            };
-            Some(Donor {
-                item,
-                part,
-                offset: rng.below(donor_len - len + 1),
-                text,
-            })
-        })
-    }
-
     /// How often each item is drawn, relative to the others: `n^-balance` for an item whose
     /// action has `n` items (unlabelled items count as one action). 0 draws every item
     /// equally often; 1 draws every action equally often, however rare.
@@ -178,13 +130,6 @@ impl TokenSet {
     /// is the motion's own sentence for that part with probability `draw.part_text`, else one
     /// of its global captions (the same for all parts that use it); the whole text is dropped
     /// with probability `draw.drop_text`.
-    ///
-    /// With probability `draw.splice` a motion's left or right arm (all layers) is replaced by
-    /// that arm in a window of another motion at least as long (drawn the same way), and that
-    /// arm is conditioned on the other motion's sentence for the arm or, as often, one of its
-    /// global captions. The dataset never shows, say, a walk with a waving arm; spliced motions
-    /// teach the transformer to follow an arm's own text when the rest of the body does
-    /// something else, as a body-part edit asks it to.
     pub fn batch(
         &self,
         config: &TransformerConfig,
@@ -197,7 +142,6 @@ impl TokenSet {
             part_text,
             drop_text,
             weights,
-            splice,
         } = *draw;
         let total: f64 = weights.map_or(0.0, |w| w.iter().sum());
         let draw = |rng: &mut Rng| match weights {
@@ -237,32 +181,17 @@ impl TokenSet {
         let mut keep = Vec::with_capacity(batch * PARTS);
         let mut pad = Vec::with_capacity(batch * n);
         for item in &picks {
-            let len = item.tokens[0][0].len();
-            let spliced = (rng.uniform() < splice)
-                .then(|| self.splice_donor(len, rng, &draw))
-                .flatten();
-            for (p, part) in item.tokens.iter().enumerate() {
-                for (l, layer) in part.iter().enumerate() {
-                    match &spliced {
-                        Some(d) if d.part == p => tokens.extend(
-                            d.item.tokens[p][l][d.offset..d.offset + len]
-                                .iter()
-                                .map(|t| *t as i32),
-                        ),
-                        _ => tokens.extend(layer.iter().map(|t| *t as i32)),
-                    }
+            for part in &item.tokens {
+                for layer in part {
+                    tokens.extend(layer.iter().map(|t| *t as i32));
                     tokens.extend(std::iter::repeat_n(pad_id, n - layer.len()));
                 }
             }
             let global = item.captions.get(rng.below(item.captions.len())).copied();
             let dropped = rng.uniform() < drop_text;
             for p in 0..PARTS {
-                let chosen = match &spliced {
-                    Some(d) if d.part == p => Some(d.text),
-                    _ => item.parts[p]
-                        .filter(|_| rng.uniform() < part_text)
-                        .or(global),
-                };
+                let own = item.parts[p].filter(|_| rng.uniform() < part_text);
+                let chosen = own.or(global);
                 match chosen {
                     Some(t) => text.extend_from_slice(&self.embeddings[t]),
                     None => text.extend(std::iter::repeat_n(0.0, TEXT_DIM)),
@@ -273,6 +202,7 @@ impl TokenSet {
                     1.0
                 });
             }
+            let len = item.tokens[0][0].len();
             pad.extend((0..n).map(|s| (s >= len) as i32));
         }
         TokenBatch {

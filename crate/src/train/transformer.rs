@@ -54,12 +54,6 @@ pub struct TransformerTrainingConfig {
     pub balance: f64,
     #[config(default = 0)]
     pub balance_from: usize,
-    /// Probability that a training motion's arm is replaced by the arm of another motion, with
-    /// that motion's text for the arm (see `TokenSet::batch`), from step `splice_from` on.
-    #[config(default = 0.0)]
-    pub splice: f64,
-    #[config(default = 0)]
-    pub splice_from: usize,
 }
 
 /// Inputs and targets of one step.
@@ -223,11 +217,6 @@ pub fn train_transformer(
             part_text: config.part_text as f32,
             drop_text: config.drop_text as f32,
             weights: weights.as_deref().filter(|_| step >= config.balance_from),
-            splice: if step >= config.splice_from {
-                config.splice as f32
-            } else {
-                0.0
-            },
         };
         let batch = data.batch(&config.model, &mut rng, &draw, device);
         let inputs = match kind {
@@ -376,7 +365,6 @@ mod tests {
                 part_text: 0.0,
                 drop_text: 0.0,
                 weights: Some(&only_bows),
-                splice: 0.0,
             };
             let batch = set.batch(&config().model, &mut rng, &draw, &device);
             for len in &batch.lengths {
@@ -399,7 +387,6 @@ mod tests {
             part_text: 0.3,
             drop_text: 0.1,
             weights: None,
-            splice: 0.0,
         };
         let batch = set.batch(&cfg.model, &mut rng, &draw, &device);
         let (b, layers, n) = batch.dims;
@@ -418,74 +405,6 @@ mod tests {
                 assert_eq!(inputs[i], cfg.model.pad_id() as i64);
             }
         }
-    }
-
-    #[test]
-    fn a_spliced_arm_comes_from_another_motion_with_that_motion_s_text() {
-        // Every token of item i is i, so a row's tokens tell which motion each part came from;
-        // caption of item i: text i; left-arm sentence: 12 + i; right arm: 24 + i.
-        let items = (0..12)
-            .map(|i| TokenItem {
-                tokens: vec![vec![vec![i as u32; 3 + i % 5]; 3]; PARTS],
-                captions: vec![i],
-                parts: [Some(12 + i), Some(24 + i), None, None],
-                content: None,
-            })
-            .collect();
-        let set = TokenSet {
-            items,
-            texts: (0..36).map(|i| format!("text {i}")).collect(),
-            embeddings: (0..36).map(|i| [i as f32; TEXT_DIM]).collect(),
-        };
-        let cfg = config();
-        let device = Device::flex();
-        let mut spliced = 0;
-        for seed in 0..10 {
-            let draw = BatchDraw {
-                batch: 4,
-                part_text: 0.0,
-                drop_text: 0.0,
-                weights: None,
-                splice: 1.0,
-            };
-            let batch = set.batch(&cfg.model, &mut Rng::new(seed), &draw, &device);
-            let (b, layers, n) = batch.dims;
-            let text: Vec<f32> = batch.text.clone().try_into_vec_as::<f32>().unwrap();
-            for row in 0..b {
-                let len = batch.lengths[row];
-                let source = |p: usize| {
-                    let at = (row * PARTS + p) * layers * n;
-                    let first = batch.tokens[at] as usize;
-                    for l in 0..layers {
-                        let steps = &batch.tokens[at + l * n..at + l * n + len];
-                        assert!(
-                            steps.iter().all(|t| *t as usize == first),
-                            "one source a part"
-                        );
-                    }
-                    first
-                };
-                let part_text = |p: usize| text[(row * PARTS + p) * TEXT_DIM] as usize;
-                let own = source(2);
-                assert_eq!(source(3), own, "the legs stay together");
-                assert_eq!(
-                    (part_text(2), part_text(3)),
-                    (own, own),
-                    "legs: own caption"
-                );
-                let donors: Vec<usize> = (0..2).filter(|&p| source(p) != own).collect();
-                assert!(donors.len() <= 1, "at most one arm is replaced");
-                for p in donors {
-                    let donor = source(p);
-                    assert!(3 + donor % 5 >= len, "the donor is at least as long");
-                    let donor_texts = [donor, 12 * (p + 1) + donor];
-                    assert!(donor_texts.contains(&part_text(p)), "the donor's text");
-                    assert_eq!(part_text(1 - p), own, "the other arm keeps the caption");
-                    spliced += 1;
-                }
-            }
-        }
-        assert!(spliced >= 20, "{spliced} of 40 rows spliced");
     }
 
     #[test]
