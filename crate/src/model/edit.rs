@@ -78,6 +78,16 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = steps_for_frames(frames, self.base_config.max_steps - 1);
+        self.generate_steps(text, n, options).await
+    }
+
+    /// A new motion of exactly `n` time steps.
+    async fn generate_steps(
+        &self,
+        text: &PartText,
+        n: usize,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
         self.fill(text, None, &vec![vec![true; n]; PARTS], options)
             .await
     }
@@ -125,9 +135,7 @@ impl Spam {
                 text[first]
             }
         });
-        let donor = self
-            .fill(&donor_text, None, &vec![vec![true; n]; PARTS], options)
-            .await;
+        let donor = self.generate_steps(&donor_text, n, options).await;
         let mut edited = tokens.clone();
         for p in chosen {
             edited[p] = donor[p].clone();

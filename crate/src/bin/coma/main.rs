@@ -481,6 +481,11 @@ fn action_probe(
     args: ActionArgs,
 ) -> Result<()> {
     use coma::eval::probes::{action, quantile, real_performances};
+    anyhow::ensure!(
+        args.seconds > 0.0 && args.seconds.is_finite(),
+        "--seconds must be a positive number, not {}",
+        args.seconds
+    );
     let set = coma::train::motions::MotionSet::load(&args.data, coma::dataset::Split::Train)?;
     let real = real_performances(&set, probe);
     anyhow::ensure!(
@@ -506,11 +511,6 @@ fn action_probe(
         Some(k) => format!(", top-k {k}, temperature {}", args.temperature),
         None => format!(", temperature {}", args.temperature),
     };
-    anyhow::ensure!(
-        args.seconds > 0.0 && args.seconds.is_finite(),
-        "--seconds must be a positive number, not {}",
-        args.seconds
-    );
     for r in action(
         generator,
         probe,
