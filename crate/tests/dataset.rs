@@ -176,10 +176,10 @@ fn missing_archive_gives_a_clear_error() {
 #[test]
 fn training_loads_the_split_crops_it_and_resumes_a_run() {
     use burn::prelude::*;
+    use coma::dataset::motions::MotionSet;
     use coma::dataset::Split;
     use coma::model::vq::VqConfig;
     use coma::rng::Rng;
-    use coma::train::motions::MotionSet;
     use coma::train::vq::{train_vq, VqTrainOptions, VqTrainingConfig};
 
     let tmp = tempfile::tempdir().unwrap();

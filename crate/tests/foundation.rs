@@ -175,7 +175,7 @@ fn bandai_bow_bends_forward_and_comes_back() {
 fn bvh_written_and_read_back_gives_the_same_joints_within_a_millimetre() {
     let (feats, _) = canonical(WALK, false);
     let poses = features::features_to_joints(&feats);
-    let text = bvh::writer::write_bvh(&poses, features::FPS).unwrap();
+    let text = bvh::writer::write_bvh(&poses, coma::timing::FPS).unwrap();
     let back = bvh::to_smpl_motion(&Bvh::parse(&text).unwrap()).unwrap();
     assert_eq!(back.len(), poses.len());
     let worst = skeleton::max_joint_distance(&poses, &back);

@@ -9,7 +9,8 @@ use crate::ui::{
     about::About, prompt::PromptBox, settings::Settings, status::StatusBar, steps::Steps,
     timeline::Timeline, toolbar::Toolbar, viewer::Viewer,
 };
-use coma::agents::plan::Plan;
+use coma::plan::Plan;
+use coma::session::{Command, Outcome, Progress, RunOutcome};
 use coma::share::{self, Edit};
 use leptos::prelude::*;
 
@@ -95,8 +96,13 @@ impl AppState {
         });
     }
 
-    /// Sends a request whose motion becomes `pending`; refused while another one runs.
-    pub fn request(&self, request: Request, pending: Pending) {
+    /// Sends an engine command (with the LLM to use, if any) whose motion becomes `pending`;
+    /// refused while another one runs.
+    pub fn request(&self, command: Command, llm: Option<LlmSettings>, pending: Pending) {
+        let request = Request::Execute {
+            command: Box::new(command),
+            llm,
+        };
         if self.busy() {
             self.fail("wait for the current step to finish");
             return;
@@ -123,12 +129,15 @@ impl AppState {
 
     /// Writes the current take into the URL fragment, so the address is the share link.
     pub fn publish(&self) {
-        let (Some(take), Some(model)) = (self.take(), self.model.get_untracked()) else {
-            return;
-        };
-        if let Some(id) = share::model_id_bytes(&model.id) {
-            crate::browser::set_fragment(&share::encode(&take.shared(id)));
+        if let Some(link) = self.link() {
+            crate::browser::set_fragment(&link);
         }
+    }
+
+    /// The current take's share link (the fragment, without `#`), if there is a take.
+    fn link(&self) -> Option<String> {
+        let (take, model) = (self.take()?, self.model.get_untracked()?);
+        share::model_id_bytes(&model.id).map(|id| share::encode(&take.shared(id)))
     }
 }
 
@@ -152,7 +161,7 @@ fn on_reply(state: AppState, reply: Reply) {
                 state.fail(e);
             }
         }
-        Reply::Progress { stage, done, total } => state.progress.set(Some((stage, done, total))),
+        Reply::Loading { stage, done, total } => state.progress.set(Some((stage, done, total))),
         Reply::Loaded {
             model_id,
             backend,
@@ -187,57 +196,22 @@ fn on_reply(state: AppState, reply: Reply) {
             }));
             open_link(state);
         }
-        Reply::Plan { plan } => match crate::planning::parse_plan(&plan) {
-            Ok(plan) => state.preview.set(Some(plan)),
-            Err(e) => state.fail(format!("the worker's plan does not read: {e}")),
-        },
-        Reply::Step { line, done, total } => {
+        Reply::Progress {
+            progress: Progress::Planned { plan },
+        } => state.preview.set(Some(plan)),
+        Reply::Progress {
+            progress: Progress::Step { line, done, total },
+        } => {
             state.progress.set(Some((line.clone(), done, total)));
             state.steps.update(|s| s.push(line));
         }
-        Reply::Run {
-            motion,
-            plan,
-            history,
-            notes,
-            scores,
+        Reply::Done {
+            outcome: Outcome::Run(run),
             millis,
-        } => {
-            state.progress.set(None);
-            state.preview.set(None);
-            let Some(Pending::Run { prompt, seed }) = state.pending.get_untracked() else {
-                state.pending.set(None);
-                return;
-            };
-            state.pending.set(None);
-            let plan = match crate::planning::parse_plan(&plan) {
-                Ok(plan) => plan,
-                Err(e) => return state.fail(format!("the worker's plan does not read: {e}")),
-            };
-            state.generate_millis.set(Some(millis));
-            let mut take = Take::new(motion, prompt, seed, history, Some(plan), Vec::new());
-            take.scores = scores;
-            take.steps = state.steps.get_untracked();
-            let summary = match notes.first() {
-                None => format!("Done in {:.1} s.", millis / 1000.0),
-                Some(first) => format!(
-                    "Done in {:.1} s. Note: {first}{}",
-                    millis / 1000.0,
-                    if notes.len() > 1 {
-                        format!(" (and {} more under Steps)", notes.len() - 1)
-                    } else {
-                        String::new()
-                    }
-                ),
-            };
-            take.notes = notes;
-            show(state, take);
-            state.say(summary);
-        }
-        Reply::Motion {
-            motion,
+        } => on_run(state, *run, millis),
+        Reply::Done {
+            outcome: Outcome::Motion { motion, notes },
             millis,
-            notes,
         } => {
             state.progress.set(None);
             let pending = state.pending.get_untracked();
@@ -258,7 +232,8 @@ fn on_reply(state: AppState, reply: Reply) {
                         plan_from_link(&link.plan, &link.prompt, motion.joints.len());
                     let mut take =
                         Take::new(motion, link.prompt, link.seed, link.history, plan, legacy);
-                    take.restore_record(&link.record);
+                    take.restore_record(link.record);
+                    take.notes.extend(link.notes);
                     take
                 }
                 Some(Pending::Run { .. }) | None => return,
@@ -269,6 +244,14 @@ fn on_reply(state: AppState, reply: Reply) {
                 Some(note) => format!("Done in {:.1} s. Note: {note}", millis / 1000.0),
             });
         }
+        // The page asks for no plan alone.
+        Reply::Done {
+            outcome: Outcome::Plan { .. },
+            ..
+        } => {
+            state.progress.set(None);
+            state.pending.set(None);
+        }
         Reply::Error { message } => {
             state.progress.set(None);
             state.pending.set(None);
@@ -276,6 +259,45 @@ fn on_reply(state: AppState, reply: Reply) {
             state.fail(message);
         }
     }
+}
+
+/// A run's motion becomes the new take, with its plan, steps, review scores and notes.
+fn on_run(state: AppState, run: RunOutcome, millis: f64) {
+    state.progress.set(None);
+    state.preview.set(None);
+    let Some(Pending::Run { prompt, seed }) = state.pending.get_untracked() else {
+        state.pending.set(None);
+        return;
+    };
+    state.pending.set(None);
+    state.generate_millis.set(Some(millis));
+    let scores = run.scores();
+    let notes = run.all_notes();
+    let mut take = Take::new(
+        run.motion,
+        prompt,
+        seed,
+        run.history,
+        Some(run.plan),
+        Vec::new(),
+    );
+    take.scores = scores;
+    take.steps = state.steps.get_untracked();
+    let summary = match notes.first() {
+        None => format!("Done in {:.1} s.", millis / 1000.0),
+        Some(first) => format!(
+            "Done in {:.1} s. Note: {first}{}",
+            millis / 1000.0,
+            if notes.len() > 1 {
+                format!(" (and {} more under Steps)", notes.len() - 1)
+            } else {
+                String::new()
+            }
+        ),
+    };
+    take.notes = notes;
+    show(state, take);
+    state.say(summary);
 }
 
 /// Makes `take` the current state (undoable), plays it and puts it in the address.
@@ -288,11 +310,15 @@ fn show(state: AppState, take: Take) {
 
 /// Opens the share link in the URL, if there is one.
 fn open_link(state: AppState) {
-    let fragment = crate::browser::fragment();
+    open_fragment(state, &crate::browser::fragment());
+}
+
+/// Opens `fragment` (a URL fragment without `#`) if it is a share link.
+fn open_fragment(state: AppState, fragment: &str) {
     if fragment.is_empty() {
         return;
     }
-    match share::decode(&fragment) {
+    match share::decode(fragment) {
         Err(share::LinkError::NotALink) => {}
         Err(e) => state.fail(format!("This link cannot be opened: {e}.")),
         Ok(link) => {
@@ -309,15 +335,56 @@ fn open_link(state: AppState) {
             } else {
                 state.say("opening the shared motion…");
                 state.request(
-                    Request::Decode {
+                    Command::Decode {
                         tokens: link.tokens.clone(),
-                        plan: Some(link.plan.clone()),
+                        plan: link.plan.plan().cloned(),
                     },
+                    None,
                     Pending::Link(link),
                 );
             }
         }
     }
+}
+
+/// Opens a share link pasted into the address bar of this tab, where only the fragment
+/// changes and the page does not reload, as [`open_link`] opens one at load. Before the model
+/// has loaded, the load opens whatever link the address holds then. The page's own writes
+/// (`publish`, by replaceState) fire no hashchange, and a link equal to the current take's is
+/// not reopened. A link that comes while a request runs opens when that request is done.
+fn watch_links(state: AppState) {
+    let waiting = StoredValue::new(None::<String>);
+    let watched = crate::browser::on_fragment_change(move || {
+        let fragment = crate::browser::fragment();
+        if state.model.with_untracked(Option::is_none)
+            || matches!(share::decode(&fragment), Err(share::LinkError::NotALink))
+            || state.link().as_deref() == Some(fragment.as_str())
+        {
+            return;
+        }
+        if state.busy() {
+            waiting.set_value(Some(fragment));
+            state.say("The pasted link opens when the current step is done.");
+        } else {
+            waiting.set_value(None);
+            state.foreign_link.set(None);
+            open_fragment(state, &fragment);
+        }
+    });
+    if let Err(e) = watched {
+        state.fail(e);
+    }
+    // Runs after the reply that ended the request is handled (its take shown and published).
+    Effect::new(move |_| {
+        if state.pending.with(Option::is_none) {
+            if let Some(fragment) = waiting.try_update_value(Option::take).flatten() {
+                untrack(|| {
+                    state.foreign_link.set(None);
+                    open_fragment(state, &fragment);
+                });
+            }
+        }
+    });
 }
 
 #[component]
@@ -342,6 +409,7 @@ pub fn App() -> impl IntoView {
         client: StoredValue::new_local(None),
     };
     provide_context(state);
+    watch_links(state);
     match Client::spawn("./static/worker.js", move |reply| on_reply(state, reply)) {
         Ok(client) => state.client.set_value(Some(client)),
         Err(e) => state.fail(e),

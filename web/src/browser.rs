@@ -73,6 +73,19 @@ pub fn set_fragment(fragment: &str) {
     }
 }
 
+/// Calls `on_change` whenever a navigation changes the URL fragment (a link pasted into the
+/// address bar, back and forward), as long as the page lives. [`set_fragment`] does not call
+/// it: replaceState fires no hashchange.
+pub fn on_fragment_change(on_change: impl FnMut() + 'static) -> Result<(), String> {
+    let listener = wasm_bindgen::closure::Closure::<dyn FnMut()>::new(on_change);
+    window()?
+        .add_event_listener_with_callback("hashchange", listener.as_ref().unchecked_ref())
+        .map_err(|e| format!("cannot watch the address for share links: {e:?}"))?;
+    // The page listens until it is closed.
+    listener.forget();
+    Ok(())
+}
+
 /// `relative` resolved against the page's address (the worker resolves relative URLs against
 /// its own script, so it is given absolute ones).
 pub fn absolute_url(relative: &str) -> String {

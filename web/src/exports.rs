@@ -3,8 +3,9 @@
 //! features, or the (T, 22, 3) joints).
 
 use crate::take::Take;
-use coma::features::{features_to_npy, joints_to_npy, FeatureFrame, FEATURE_DIM, FPS};
+use coma::features::{features_to_npy, joints_to_npy};
 use coma::skeleton::Pose;
+use coma::timing::FPS;
 
 /// The export formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,8 +72,7 @@ pub fn export(take: &Take, format: Format) -> Result<Vec<u8>, String> {
             let mut json = coma::motion_file::joints_to_json(&poses(take));
             json["prompt"] = take.prompt.clone().into();
             json["seed"] = take.seed.into();
-            json["plan"] =
-                serde_json::from_str(&take.plan_json()).unwrap_or(serde_json::Value::Null);
+            json["plan"] = serde_json::to_value(&take.plan).unwrap_or(serde_json::Value::Null);
             // Where each segment lies in the frames, which the plan itself (in seconds)
             // does not say exactly.
             json["segments"] = take
@@ -82,21 +82,7 @@ pub fn export(take: &Take, format: Format) -> Result<Vec<u8>, String> {
                 .collect();
             Ok(json.to_string().into_bytes())
         }
-        Format::FeaturesNpy => {
-            let rows: Vec<FeatureFrame> = take
-                .motion
-                .features
-                .iter()
-                .map(|f| {
-                    let mut row = [0.0f32; FEATURE_DIM];
-                    for (r, v) in row.iter_mut().zip(f) {
-                        *r = *v;
-                    }
-                    row
-                })
-                .collect();
-            Ok(features_to_npy(&rows).to_bytes_f32())
-        }
+        Format::FeaturesNpy => Ok(features_to_npy(&take.motion.features).to_bytes_f32()),
         Format::JointsNpy => Ok(joints_to_npy(&poses(take)).to_bytes_f32()),
     }
 }
@@ -104,8 +90,10 @@ pub fn export(take: &Take, format: Format) -> Result<Vec<u8>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::messages::Motion;
-    use crate::take::segments_from_plan;
+    use crate::take::plan_from_link;
+    use coma::features::FEATURE_DIM;
+    use coma::session::Motion;
+    use coma::share::LinkPlan;
 
     fn take() -> Take {
         // A standing pose from the reference skeleton, swaying.
@@ -128,15 +116,16 @@ mod tests {
             .collect();
         Take::new(
             Motion {
-                tokens: vec![vec![vec![1, 2]; 4]; 4],
-                features: vec![vec![0.5; FEATURE_DIM]; 9],
+                tokens: coma::model::tokens::MotionTokens::new(vec![vec![vec![1, 2]; 4]; 4])
+                    .unwrap(),
+                features: vec![[0.5; FEATURE_DIM]; 9],
                 joints,
             },
             "a person sways".into(),
             3,
             vec![],
             None,
-            segments_from_plan("", "a person sways", 10),
+            plan_from_link(&LinkPlan::None, "a person sways", 10).1,
         )
     }
 
@@ -150,7 +139,8 @@ mod tests {
             serde_json::from_slice(&export(&t, Format::Json).unwrap()).unwrap();
         assert_eq!(json["frames"].as_array().unwrap().len(), 10);
         assert_eq!(json["prompt"], "a person sways");
-        assert_eq!(json["plan"]["segments"][0]["to"], 10);
+        // A take without the planner's plan has its segments only.
+        assert_eq!(json["plan"], serde_json::Value::Null);
         assert_eq!(json["segments"][0]["to"], 10);
         // A planned take exports the planner's whole plan.
         let mut planned = t.clone();

@@ -2,13 +2,13 @@
 //! in a Web Worker), built from this one wasm module. [`start`] mounts the app in a window;
 //! [`worker_main`] is called by `static/worker.js` inside the worker.
 //!
-//! The modules without a browser in them (messages, history, takes, exports, planning, the
-//! viewer's scene) build and test natively; the rest only for wasm32.
+//! The modules without a browser in them (messages, the worker's dispatch, history, takes,
+//! exports, the viewer's scene) build and test natively; the rest only for wasm32.
 
+pub mod dispatch;
 pub mod exports;
 pub mod history;
 pub mod messages;
-pub mod planning;
 pub mod take;
 pub mod viewer;
 

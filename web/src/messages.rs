@@ -1,12 +1,10 @@
 //! What the page and its inference worker say to each other. Messages cross the worker
-//! boundary as JSON text, so both sides share these types and nothing else.
+//! boundary as JSON text; besides loading, the page sends the engine's own [`Command`]s and
+//! the worker answers with the engine's [`Progress`] and [`Outcome`], so both sides share the
+//! library's types and nothing else.
 
-use coma::model::generate::MotionTokens;
-use coma::share::Edit;
+use coma::session::{Command, Outcome, Progress};
 use serde::{Deserialize, Serialize};
-
-/// A body part in the user's words: "left arm", "right arm", "left leg", "right leg".
-pub type PartName = String;
 
 /// A request from the page to the worker.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -20,58 +18,17 @@ pub enum Request {
         #[serde(default)]
         backend: Option<Backend>,
     },
-    /// The whole CoMA loop: plan `prompt` (with the LLM in `llm`, else the built-in planner),
-    /// then generate, edit, review for up to `rounds` rounds and blend. `plan` (a plan's JSON,
-    /// e.g. a link's) skips planning; `seconds` stretches or shrinks the plan to that length.
-    Run {
-        prompt: String,
-        seed: u64,
-        rounds: usize,
-        #[serde(default)]
-        seconds: Option<f64>,
+    /// Carry out an engine command; `llm` (the Settings panel's endpoint) plans and judges
+    /// where it is given.
+    Execute {
+        command: Box<Command>,
         #[serde(default)]
         llm: Option<LlmSettings>,
-        #[serde(default)]
-        plan: Option<String>,
-    },
-    /// A new motion of `seconds` from `prompt`; `parts` give some body parts their own
-    /// instruction.
-    Generate {
-        prompt: String,
-        seconds: f64,
-        seed: u64,
-        parts: Vec<(PartName, String)>,
-    },
-    /// Regenerate frames `from..to` (20 fps) of every part from `text`. `plan` (JSON) lays
-    /// its segments' paths on the result, as on every request that carries tokens.
-    InBetween {
-        tokens: MotionTokens,
-        text: String,
-        from: usize,
-        to: usize,
-        seed: u64,
-        #[serde(default)]
-        plan: Option<String>,
-    },
-    /// Regenerate the named parts from `text`; the others keep doing what they do.
-    EditParts {
-        tokens: MotionTokens,
-        text: String,
-        parts: Vec<PartName>,
-        seed: u64,
-        #[serde(default)]
-        plan: Option<String>,
-    },
-    /// Decode tokens (from a share link) into a motion.
-    Decode {
-        tokens: MotionTokens,
-        #[serde(default)]
-        plan: Option<String>,
     },
 }
 
 /// An OpenAI-compatible endpoint, as the Settings panel keeps it. The key crosses to the
-/// worker inside a [`Request::Run`] and goes nowhere else: Debug hides it, and nothing that
+/// worker inside a [`Request::Execute`] and goes nowhere else: Debug hides it, and nothing that
 /// is shared or exported holds these settings.
 #[derive(Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct LlmSettings {
@@ -117,24 +74,14 @@ pub enum Backend {
     Cpu,
 }
 
-/// A generated or decoded motion.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Motion {
-    pub tokens: MotionTokens,
-    /// Joint positions per frame (20 fps, metres, Y up), 22 joints.
-    pub joints: Vec<[[f32; 3]; 22]>,
-    /// HumanML3D features per frame (not normalised), for the NPY export.
-    pub features: Vec<Vec<f32>>,
-}
-
 /// A reply from the worker.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Reply {
     /// The worker's wasm is running and takes requests.
     Ready,
-    /// Progress of the current request: `stage` in words, `done` of `total` units.
-    Progress {
+    /// Progress of loading the models: `stage` in words, `done` of `total` files.
+    Loading {
         stage: String,
         done: u64,
         total: u64,
@@ -152,41 +99,12 @@ pub enum Reply {
         #[serde(default)]
         missing: Vec<String>,
     },
-    /// The result of a Generate, InBetween, EditParts or Decode request.
-    Motion {
-        motion: Motion,
-        millis: f64,
-        /// Paths of the plan that could not be laid (the motion keeps its own root there).
-        #[serde(default)]
-        notes: Vec<String>,
-    },
-    /// A Run has its plan (the [`coma::agents::plan::Plan`] as JSON); the motion follows.
-    Plan { plan: String },
-    /// A step of a Run ended: one line for the user, `done` of about `total` steps.
-    Step { line: String, done: u64, total: u64 },
-    /// A Run's result: the motion, the plan it followed, every step as a link records it,
-    /// the planner's and the run's notes, and how the review scored each segment.
-    Run {
-        motion: Motion,
-        plan: String,
-        history: Vec<Edit>,
-        notes: Vec<String>,
-        scores: Vec<SegmentScores>,
-        millis: f64,
-    },
+    /// The command in flight reports progress.
+    Progress { progress: Progress },
+    /// The command is done, in `millis` milliseconds.
+    Done { outcome: Outcome, millis: f64 },
     /// The request failed; the page keeps its last good state.
     Error { message: String },
-}
-
-/// How the reviewer scored one segment: the evaluator's 0–100 similarity of its text with its
-/// motion before and after review (none without an evaluator), and the rounds it took.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SegmentScores {
-    pub before: Option<f64>,
-    pub after: Option<f64>,
-    pub rounds: usize,
-    /// Rounds whose corrections were kept.
-    pub kept: usize,
 }
 
 /// Encodes a message for `postMessage`.
@@ -220,13 +138,12 @@ mod tests {
         assert_eq!(active.base_url, "http://127.0.0.1:11434/v1");
         let shown = format!(
             "{:?}",
-            Request::Run {
-                prompt: "p".into(),
-                seed: 0,
-                rounds: 0,
-                seconds: None,
+            Request::Execute {
+                command: Box::new(Command::Plan {
+                    prompt: "p".into(),
+                    seconds: None,
+                }),
                 llm: Some(active),
-                plan: None,
             }
         );
         assert!(!shown.contains("sk-very"), "{shown}");
@@ -240,14 +157,18 @@ mod tests {
 
     #[test]
     fn messages_round_trip_as_json() {
-        let request = Request::Generate {
-            prompt: "a person walks forward".into(),
-            seconds: 4.0,
-            seed: 7,
-            parts: vec![("left arm".into(), "waves".into())],
+        let request = Request::Execute {
+            command: Box::new(Command::Generate {
+                prompt: "a person walks forward".into(),
+                seconds: 4.0,
+                seed: 7,
+                parts: vec![(coma::skeleton::BodyPart::LeftArm, "waves".into())],
+            }),
+            llm: None,
         };
         let text = to_json(&request);
         assert!(text.contains(r#""type":"generate""#), "{text}");
+        assert!(text.contains(r#""left_arm""#), "{text}");
         assert_eq!(from_json::<Request>(&text).unwrap(), request);
         let reply = Reply::Loaded {
             model_id: "0123456789abcdef".into(),
@@ -258,21 +179,18 @@ mod tests {
             missing: vec![],
         };
         assert_eq!(from_json::<Reply>(&to_json(&reply)).unwrap(), reply);
-        let run = Request::Run {
-            prompt: "a person bows".into(),
-            seed: 1,
-            rounds: 2,
-            seconds: None,
-            llm: None,
-            plan: None,
+        let step = Reply::Progress {
+            progress: Progress::Step {
+                line: "segment 1: generated".into(),
+                done: 1,
+                total: 3,
+            },
         };
-        assert_eq!(from_json::<Request>(&to_json(&run)).unwrap(), run);
-        // The page's older requests, without a plan, still read.
-        let decode = r#"{"type":"decode","tokens":[[[1,2]]]}"#;
-        assert!(matches!(
-            from_json::<Request>(decode).unwrap(),
-            Request::Decode { plan: None, .. }
-        ));
+        assert_eq!(from_json::<Reply>(&to_json(&step)).unwrap(), step);
+        // Tokens are checked as the message is read.
+        let decode = r#"{"type":"execute","command":{"type":"decode","tokens":[[[1,2]]]}}"#;
+        let e = from_json::<Request>(decode).unwrap_err();
+        assert!(e.contains("4 body parts"), "{e}");
         assert!(from_json::<Request>("{\"type\":\"launch\"}")
             .unwrap_err()
             .starts_with("unreadable message"));

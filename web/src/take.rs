@@ -2,14 +2,10 @@
 //! (prompt, seed, plan, the edits so far, the segments), as undo keeps it and a share link
 //! carries it.
 
-use crate::messages::{Motion, SegmentScores};
-use coma::agents::plan::Plan;
-use coma::model::motion_model::frames_for_seconds;
-use coma::share::{Edit, EditKind, SharedMotion};
-use serde::{Deserialize, Serialize};
-
-/// Frames per token step: segments start and end on whole steps.
-const STEP_FRAMES: usize = 4;
+use coma::plan::Plan;
+use coma::session::Motion;
+use coma::share::{Edit, EditKind, LinkPlan, LinkSegment, RunRecord, SegmentScores, SharedMotion};
+use coma::timing::{frames_for_seconds, seconds, FRAMES_PER_TOKEN};
 
 /// A stretch of the motion with its own text, in frames at 20 fps, and what the plan asked
 /// of it.
@@ -28,7 +24,7 @@ pub struct Segment {
 
 impl Segment {
     pub fn seconds(&self) -> f64 {
-        (self.to - self.from) as f64 / 20.0
+        seconds(self.to - self.from)
     }
 }
 
@@ -48,31 +44,6 @@ pub struct Take {
     /// The lines of the run that made the take, one a step (plan, generation, edits, review
     /// rounds, blend), as the Steps panel showed them.
     pub steps: Vec<String>,
-}
-
-/// How the run of a take went, as its share link keeps it (the link's `record`), so that
-/// an opened link shows the same steps, scores and notes.
-#[derive(Debug, Default, PartialEq, Serialize, Deserialize)]
-struct RunRecord {
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    steps: Vec<String>,
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    scores: Vec<SegmentScores>,
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    notes: Vec<String>,
-}
-
-/// Most lines a record keeps of each kind, and characters a line: what one run writes is far
-/// below both, so only a doctored link is cut.
-const RECORD_LINES: usize = 200;
-const RECORD_LINE_CHARS: usize = 500;
-
-fn capped(lines: Vec<String>) -> Vec<String> {
-    lines
-        .into_iter()
-        .take(RECORD_LINES)
-        .map(|l| l.chars().take(RECORD_LINE_CHARS).collect())
-        .collect()
 }
 
 impl Take {
@@ -104,35 +75,23 @@ impl Take {
         }
     }
 
-    /// The take's run record as JSON ("" when it has none).
-    fn record_json(&self) -> String {
+    /// How the run that made the take went, as its share link keeps it, so that an opened
+    /// link shows the same steps, scores and notes.
+    fn record(&self) -> Option<RunRecord> {
         let record = RunRecord {
             steps: self.steps.clone(),
             scores: self.scores.clone(),
             notes: self.notes.clone(),
         };
-        if record == RunRecord::default() {
-            return String::new();
-        }
-        serde_json::to_string(&record).unwrap_or_default()
+        (!record.is_empty()).then_some(record)
     }
 
-    /// Takes the steps, scores and notes a link recorded. A record that does not read leaves
-    /// them empty and says so in the notes: the motion itself is whole without it.
-    pub fn restore_record(&mut self, json: &str) {
-        if json.is_empty() {
-            return;
-        }
-        match serde_json::from_str::<RunRecord>(json) {
-            Ok(record) => {
-                self.steps = capped(record.steps);
-                self.notes = capped(record.notes);
-                self.scores = record.scores.into_iter().take(RECORD_LINES).collect();
-            }
-            Err(e) => self.notes.push(format!(
-                "the link's record of its run does not read ({e}), so its steps and review \
-                 scores are not shown"
-            )),
+    /// Takes the steps, scores and notes a link recorded.
+    pub fn restore_record(&mut self, record: Option<RunRecord>) {
+        if let Some(record) = record {
+            self.steps = record.steps;
+            self.scores = record.scores;
+            self.notes.extend(record.notes);
         }
     }
 
@@ -141,24 +100,20 @@ impl Take {
         self.motion.joints.len()
     }
 
-    /// The plan as JSON, as links and the worker read it.
-    pub fn plan_json(&self) -> String {
-        match &self.plan {
-            Some(plan) => serde_json::to_string(plan).unwrap_or_default(),
-            None => plan_json(&self.segments),
-        }
-    }
-
     /// What a share link of this take carries.
     pub fn shared(&self, model_id: [u8; 8]) -> SharedMotion {
         SharedMotion {
             model_id,
             seed: self.seed,
             prompt: self.prompt.clone(),
-            plan: self.plan_json(),
-            record: self.record_json(),
+            plan: match &self.plan {
+                Some(plan) => LinkPlan::Planned(plan.clone()),
+                None => LinkPlan::Segments(link_segments(&self.segments)),
+            },
+            record: self.record(),
             history: self.edits.clone(),
             tokens: self.motion.tokens.clone(),
+            notes: Vec::new(),
         }
     }
 }
@@ -170,7 +125,7 @@ pub fn plan_segments(plan: &Plan, frames: usize) -> Vec<Segment> {
     let lengths: Vec<usize> = plan
         .segments
         .iter()
-        .map(|s| frames_for_seconds(s.seconds).div_ceil(STEP_FRAMES) * STEP_FRAMES)
+        .map(|s| frames_for_seconds(s.seconds).div_ceil(FRAMES_PER_TOKEN) * FRAMES_PER_TOKEN)
         .collect();
     let total = if frames == 0 {
         lengths.iter().sum()
@@ -202,65 +157,61 @@ pub fn plan_segments(plan: &Plan, frames: usize) -> Vec<Segment> {
         .collect()
 }
 
-/// The segments as the plan a link carried before plans were the planner's (still written
-/// for takes without a plan).
-pub fn plan_json(segments: &[Segment]) -> String {
-    let list: Vec<_> = segments
+/// The segments as an older link's plan (written for takes without a planner's plan).
+fn link_segments(segments: &[Segment]) -> Vec<LinkSegment> {
+    segments
         .iter()
-        .map(|s| serde_json::json!({"text": s.text, "from": s.from, "to": s.to}))
-        .collect();
-    serde_json::json!({ "segments": list }).to_string()
+        .map(|s| LinkSegment {
+            text: s.text.clone(),
+            from: s.from,
+            to: s.to,
+        })
+        .collect()
 }
 
-/// A link's plan: the planner's plan when it reads as one, else the older segments-only
-/// form, else one segment over the whole motion with the prompt as its text.
-pub fn plan_from_link(plan: &str, prompt: &str, frames: usize) -> (Option<Plan>, Vec<Segment>) {
-    if let Ok(plan) = crate::planning::parse_plan(plan) {
-        let segments = plan_segments(&plan, frames);
-        if !segments.is_empty() {
-            return (Some(plan), segments);
-        }
-    }
-    (None, segments_from_plan(plan, prompt, frames))
-}
-
-/// Segments back from an older link's plan; a plan that does not read gives one segment
-/// over the whole motion with the prompt as its text.
-pub fn segments_from_plan(plan: &str, prompt: &str, frames: usize) -> Vec<Segment> {
-    let whole = |text: String, from, to| Segment {
-        text,
+/// A link's plan and the segments it shows over a motion of `frames` frames: the planner's
+/// plan, else an older link's segments, else one segment over the whole motion with the
+/// prompt as its text.
+pub fn plan_from_link(
+    plan: &LinkPlan,
+    prompt: &str,
+    frames: usize,
+) -> (Option<Plan>, Vec<Segment>) {
+    let whole = |text: &str, from, to| Segment {
+        text: text.chars().take(500).collect(),
         from,
         to,
         base: String::new(),
         parts: Vec::new(),
         path: None,
     };
-    let parsed: Option<Vec<Segment>> = serde_json::from_str::<serde_json::Value>(plan)
-        .ok()
-        .and_then(|v| {
-            v.get("segments")?
-                .as_array()?
-                .iter()
-                .map(|s| {
-                    let from = s.get("from")?.as_u64()? as usize;
-                    let to = s.get("to")?.as_u64()? as usize;
-                    let text: String = s.get("text")?.as_str()?.chars().take(500).collect();
-                    (from < to && to <= frames).then(|| whole(text, from, to))
-                })
-                .collect()
-        });
-    match parsed {
-        Some(s) if !s.is_empty() => s,
-        _ => vec![whole(prompt.to_string(), 0, frames)],
+    match plan {
+        LinkPlan::Planned(plan) => {
+            let segments = plan_segments(plan, frames);
+            if !segments.is_empty() {
+                return (Some(plan.clone()), segments);
+            }
+        }
+        LinkPlan::Segments(segments) if segments.iter().all(|s| s.to <= frames) => {
+            return (
+                None,
+                segments
+                    .iter()
+                    .map(|s| whole(&s.text, s.from, s.to))
+                    .collect(),
+            )
+        }
+        _ => {}
     }
+    (None, vec![whole(prompt, 0, frames)])
 }
 
 /// One line for an edit of the history, as the Steps panel lists it.
 pub fn edit_line(edit: &Edit) -> String {
     let span = format!(
         "{:.1}–{:.1} s",
-        edit.from_frame as f64 / 20.0,
-        edit.to_frame as f64 / 20.0
+        seconds(edit.from_frame as usize),
+        seconds(edit.to_frame as usize)
     );
     let parts: Vec<&str> = coma::skeleton::BodyPart::ALL
         .iter()
@@ -310,21 +261,17 @@ mod tests {
     #[test]
     fn older_plans_round_trip_and_bad_plans_fall_back_to_one_segment() {
         let segments = vec![legacy("walk forward", 0, 80), legacy("bow", 80, 120)];
-        let plan = plan_json(&segments);
-        assert_eq!(segments_from_plan(&plan, "p", 120), segments);
+        let plan = LinkPlan::Segments(link_segments(&segments));
         assert_eq!(plan_from_link(&plan, "p", 120), (None, segments.clone()));
-        for bad in [
-            "",
-            "{",
-            r#"{"segments":[{"text":"x","from":5,"to":2}]}"#,
-            r#"{"segments":[]}"#,
-        ] {
-            let (none, s) = plan_from_link(bad, "the prompt", 60);
-            assert_eq!(none, None);
-            assert_eq!(s, vec![legacy("the prompt", 0, 60)]);
-        }
-        // A segment beyond the motion is not believed either.
-        assert_eq!(segments_from_plan(&plan, "p", 100).len(), 1);
+        // A segment beyond the motion is not believed.
+        assert_eq!(
+            plan_from_link(&plan, "the prompt", 100),
+            (None, vec![legacy("the prompt", 0, 100)])
+        );
+        assert_eq!(
+            plan_from_link(&LinkPlan::None, "the prompt", 60),
+            (None, vec![legacy("the prompt", 0, 60)])
+        );
     }
 
     #[test]
@@ -334,7 +281,7 @@ mod tests {
             None,
         );
         // 4 + 5 + 3 s of token steps, as blended.
-        let tokens: coma::model::generate::MotionTokens = vec![vec![vec![0; 60]; 1]; 4];
+        let tokens = coma::model::tokens::MotionTokens::new(vec![vec![vec![0; 60]; 1]; 4]).unwrap();
         let ranges = coma::agents::pipeline::segment_ranges(&plan, &tokens);
         let segments = plan_segments(&plan, 240);
         let ours: Vec<_> = segments.iter().map(|s| s.from..s.to).collect();
@@ -345,15 +292,14 @@ mod tests {
         assert_eq!(plan_segments(&plan, 0), segments);
         // A shorter motion (a link's) cuts the segments that do not fit.
         assert_eq!(plan_segments(&plan, 100).len(), 2);
-        let json = serde_json::to_string(&plan).unwrap();
-        let (read, again) = plan_from_link(&json, "p", 240);
+        let (read, again) = plan_from_link(&LinkPlan::Planned(plan.clone()), "p", 240);
         assert_eq!((read.as_ref(), again), (Some(&plan), segments));
     }
 
     #[test]
-    fn a_link_keeps_the_run_record_and_a_bad_record_leaves_a_note() {
+    fn a_link_keeps_the_run_record() {
         let motion = Motion {
-            tokens: vec![vec![vec![7; 5]; 2]; 4],
+            tokens: coma::model::tokens::MotionTokens::new(vec![vec![vec![7; 5]; 2]; 4]).unwrap(),
             joints: vec![[[0.0; 3]; 22]; 20],
             features: Vec::new(),
         };
@@ -365,11 +311,7 @@ mod tests {
             None,
             Vec::new(),
         );
-        assert_eq!(
-            take.record_json(),
-            "",
-            "a take without a run records nothing"
-        );
+        assert_eq!(take.record(), None, "a take without a run records nothing");
         take.steps = vec![
             "segment 1: generated".into(),
             "segment 1, review round 1: kept".into(),
@@ -390,28 +332,11 @@ mod tests {
             None,
             Vec::new(),
         );
-        opened.restore_record(&link.record);
+        opened.restore_record(link.record);
         assert_eq!(
             (&opened.steps, &opened.notes, &opened.scores),
             (&take.steps, &take.notes, &take.scores)
         );
-
-        let mut doctored = Take::new(motion, "p".into(), 0, Vec::new(), None, Vec::new());
-        doctored.restore_record(&format!(
-            r#"{{"steps": ["{}"], "scores": 5}}"#,
-            "x".repeat(10)
-        ));
-        assert!(doctored.steps.is_empty() && doctored.scores.is_empty());
-        assert!(
-            doctored.notes[0].contains("does not read"),
-            "{:?}",
-            doctored.notes
-        );
-        doctored.restore_record(
-            &serde_json::json!({ "steps": vec!["y".repeat(9000); 900] }).to_string(),
-        );
-        assert_eq!(doctored.steps.len(), RECORD_LINES);
-        assert_eq!(doctored.steps[0].len(), RECORD_LINE_CHARS);
     }
 
     #[test]

@@ -3,6 +3,5 @@
 
 pub mod llm;
 pub mod pipeline;
-pub mod plan;
 pub mod planner;
 pub mod reviewer;

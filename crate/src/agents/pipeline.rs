@@ -7,18 +7,19 @@
 //! [`motion_features`] and no LLM.
 
 use crate::agents::llm::{LlmClient, Transport};
-use crate::agents::plan::{Plan, Segment};
 use crate::agents::reviewer::{self, Review, Scorer};
 use crate::features::{features_to_joints, FeatureFrame, Features};
 use crate::model::edit::PartText;
 use crate::model::generate::MotionTokens;
-use crate::model::motion_model::{frames_for_seconds, sampling};
-use crate::model::vq::DOWNSAMPLE;
+use crate::model::motion_model::sampling;
 use crate::model::MotionModel;
+use crate::plan::{Plan, Segment};
 use crate::share::{Edit, EditKind};
 use crate::skeleton::{BodyPart, Pose};
+use crate::timing::frames_for_seconds;
+use crate::timing::FRAMES_PER_TOKEN;
 use crate::trajectory::{self, circle_report, CircleReport, MapOptions, Shape, Trajectory};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Review rounds per segment by default (K in the design).
 pub const DEFAULT_ROUNDS: usize = 2;
@@ -68,7 +69,7 @@ pub enum RunEvent<'a> {
 }
 
 /// One review round as it was decided.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ReviewRound {
     pub review: Review,
     /// The corrections were applied and kept (the evaluator did not score the result lower).
@@ -80,7 +81,7 @@ pub struct ReviewRound {
 }
 
 /// What happened to one segment.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SegmentRun {
     /// Frames (20 fps) of the segment before blending.
     pub frames: usize,
@@ -91,8 +92,6 @@ pub struct SegmentRun {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub score_after: Option<f64>,
     pub rounds: Vec<ReviewRound>,
-    #[serde(skip)]
-    pub tokens: MotionTokens,
 }
 
 /// A finished run.
@@ -149,6 +148,8 @@ pub async fn run<T: Transport>(
 ) -> Run {
     let mut history = Vec::new();
     let mut segments = Vec::new();
+    // Each segment's tokens after review, to blend.
+    let mut segment_tokens = Vec::new();
     let mut notes = Vec::new();
     if options.rounds > 0 && scorer.is_none() && llm.is_none() {
         notes.push("no evaluator and no LLM: the segments were not reviewed".into());
@@ -158,7 +159,7 @@ pub async fn run<T: Transport>(
         let frames = frames_for_seconds(segment.seconds);
         let seed = seed_of(options.seed, index, 0);
         let mut tokens = model.generate(&segment.base, &[], frames, seed).await;
-        let frames = tokens[0][0].len() * DOWNSAMPLE;
+        let frames = tokens[0][0].len() * FRAMES_PER_TOKEN;
         let range = (start_frame, start_frame + frames as u32);
         history.push(Edit {
             kind: EditKind::Generate,
@@ -286,11 +287,11 @@ pub async fn run<T: Transport>(
             score_before,
             score_after: current,
             rounds,
-            tokens,
         });
+        segment_tokens.push(tokens);
         start_frame = range.1;
     }
-    let tokens = blend(model, &plan, &segments, options.seed, &mut history).await;
+    let tokens = blend(model, &plan, &segment_tokens, options.seed, &mut history).await;
     if plan.segments.len() > 1 {
         progress(RunEvent::Blended);
     }
@@ -312,28 +313,21 @@ fn condition(model: &MotionModel, segment: &Segment) -> PartText {
 async fn blend(
     model: &MotionModel,
     plan: &Plan,
-    segments: &[SegmentRun],
+    segments: &[MotionTokens],
     seed: u64,
     history: &mut Vec<Edit>,
 ) -> MotionTokens {
-    let mut joined = segments[0].tokens.clone();
-    let mut end = segments[0].frames as u32;
+    let mut joined = segments[0].clone();
+    let mut end = segments[0].frames() as u32;
     for (i, next) in segments.iter().enumerate().skip(1) {
         let seed = seed_of(seed, i, 900);
         let a = condition(model, &plan.segments[i - 1]);
         let b = condition(model, &plan.segments[i]);
         joined = model
             .spam
-            .blend(
-                &joined,
-                &next.tokens,
-                &a,
-                &b,
-                BLEND_OVERLAP_STEPS,
-                &sampling(seed),
-            )
+            .blend(&joined, next, &a, &b, BLEND_OVERLAP_STEPS, &sampling(seed))
             .await;
-        let overlap = (BLEND_OVERLAP_STEPS * DOWNSAMPLE) as u32;
+        let overlap = (BLEND_OVERLAP_STEPS * FRAMES_PER_TOKEN) as u32;
         history.push(Edit {
             kind: EditKind::Blend,
             text: String::new(),
@@ -342,7 +336,7 @@ async fn blend(
             parts: 0b1111,
             seed,
         });
-        end += next.frames as u32;
+        end += next.frames() as u32;
     }
     joined
 }
@@ -350,12 +344,13 @@ async fn blend(
 /// Feature rows of each segment in the blended motion: blending keeps every segment's
 /// length, so segment `i` starts where the ones before it end.
 pub fn segment_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range<usize>> {
-    let total = tokens[0][0].len() * DOWNSAMPLE;
+    let total = tokens[0][0].len() * FRAMES_PER_TOKEN;
     let mut start = 0;
     plan.segments
         .iter()
         .map(|s| {
-            let frames = frames_for_seconds(s.seconds).div_ceil(DOWNSAMPLE) * DOWNSAMPLE;
+            let frames =
+                frames_for_seconds(s.seconds).div_ceil(FRAMES_PER_TOKEN) * FRAMES_PER_TOKEN;
             let r = start.min(total)..(start + frames).min(total);
             start += frames;
             r
@@ -392,7 +387,7 @@ pub async fn motion_joints(model: &MotionModel, plan: &Plan, tokens: &MotionToke
 }
 
 /// How well a segment walked the path it asked for.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PathReport {
     /// Segment number, from 1.
     pub segment: usize,
@@ -502,7 +497,7 @@ pub fn describe_event(event: &RunEvent) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::agents::plan::{PartEdits, PlannerKind};
+    use crate::plan::{PartEdits, PlannerKind};
 
     fn segment(seconds: f64, parts: PartEdits) -> Segment {
         Segment {
@@ -561,7 +556,7 @@ mod tests {
             notes: Vec::new(),
         };
         // 80 frames = 20 steps, then 42 frames rounded up to 11 steps: 31 steps in all.
-        let tokens: MotionTokens = vec![vec![vec![0; 31]; 4]; 4];
+        let tokens = MotionTokens::new(vec![vec![vec![0; 31]; 4]; 4]).unwrap();
         assert_eq!(segment_ranges(&plan, &tokens), vec![0..80, 80..124]);
     }
 }

@@ -9,10 +9,10 @@
 use crate::agents::llm::{
     parse_json_content, ChatOptions, LlmClient, Message, ReplyFormat, Transport,
 };
-use crate::agents::plan::{clean_text, Segment};
-use crate::eval::evaluator::{alignment_score, Evaluator, EvaluatorConfig};
 use crate::features::FeatureFrame;
+use crate::model::evaluator::{alignment_score, Evaluator, EvaluatorConfig};
 use crate::model::MotionModel;
+use crate::plan::{clean_text, Segment};
 use crate::posecodes;
 use crate::render::{filmstrip_png, FilmstripOptions};
 use crate::skeleton::{BodyPart, Pose};
@@ -337,8 +337,8 @@ mod tests {
     use super::*;
     use crate::agents::llm::script_server::{ScriptServer, ScriptedReply};
     use crate::agents::llm::LlmConfig;
-    use crate::agents::plan::PartEdits;
     use crate::executor::block_on;
+    use crate::plan::PartEdits;
 
     fn segment() -> Segment {
         Segment {

@@ -14,9 +14,9 @@
 pub mod bandai;
 pub mod writer;
 
-use crate::features::FPS;
 use crate::geom::{self, Quat, Vec3};
 use crate::skeleton::{Pose, JOINT_NAMES, NUM_JOINTS};
+use crate::timing::FPS;
 
 /// Largest number of joints and of channel values per frame we accept, so a hostile file
 /// cannot make us allocate without bound before its data is even read.

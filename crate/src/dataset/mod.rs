@@ -18,11 +18,13 @@
 
 pub mod bandai;
 pub mod captions;
+pub mod motions;
 
 use crate::bvh::{self, Bvh};
-use crate::features::{self, FeatureStats, FPS};
+use crate::features::{self, FeatureStats};
 use crate::posecodes;
 use crate::skeleton::{self, Offsets, Pose};
+use crate::timing::{FPS, MAX_FRAMES};
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -31,8 +33,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-/// Most feature rows in one item (9.8 s at 20 fps), as HumanML3D.
-pub const MAX_FRAMES: usize = 196;
 /// Fewest feature rows in one item (1 s); shorter clips are skipped. HumanML3D keeps 2 s and
 /// more, but dataset 2's raise-hand clips last 1.2 s and carry most of the left/right arm
 /// vocabulary, so we keep them.

@@ -2,11 +2,10 @@
 //! structure, what the review loop does to text–motion similarity, and how closely a planned
 //! circle is walked.
 
-use crate::agents::llm::{LlmClient, UreqTransport};
-use crate::agents::pipeline::{self, RunOptions};
+use crate::agents::llm::UreqTransport;
 use crate::agents::planner::{offline, prompt_set};
-use crate::agents::reviewer::Scorer;
-use crate::model::MotionModel;
+use crate::executor::block_on;
+use crate::session::{Command, Llm, Outcome, RunOutcome, Session};
 use crate::trajectory::{circle_report, root_path, CircleReport};
 use serde::Serialize;
 
@@ -61,31 +60,33 @@ pub fn planner_figures(
     }
 }
 
+/// One run of the engine with no LLM (built-in planner, evaluator as judge).
+fn run(session: &Session, prompt: &str, rounds: usize, seed: u64) -> anyhow::Result<RunOutcome> {
+    let command = Command::Run {
+        prompt: prompt.to_string(),
+        seed,
+        rounds,
+        seconds: None,
+        plan: None,
+    };
+    match block_on(session.execute(command, &Llm::<UreqTransport>::Off, &mut |_| {}))? {
+        Outcome::Run(run) => Ok(*run),
+        _ => anyhow::bail!("the engine answered a run with something else"),
+    }
+}
+
 /// Runs the whole loop (built-in planner, evaluator as judge) on every prompt and compares
 /// each segment's similarity before and after review.
 pub fn review_figures(
-    model: &MotionModel,
-    scorer: &Scorer,
+    session: &Session,
     prompts: &[prompt_set::SetPrompt],
     rounds: usize,
     seed: u64,
     log: &dyn Fn(&str),
-) -> ReviewFigures {
-    let embed = |s: &str| model.text.encode(&[s])[0].to_vec();
+) -> anyhow::Result<ReviewFigures> {
     let (mut before, mut after, mut improved, mut kept) = (Vec::new(), Vec::new(), 0, 0);
     for (i, p) in prompts.iter().enumerate() {
-        let plan = offline::plan(&p.prompt, Some(&embed));
-        let run = crate::executor::block_on(pipeline::run(
-            model,
-            Some(scorer),
-            None::<&LlmClient<UreqTransport>>,
-            plan,
-            RunOptions {
-                rounds,
-                seed: seed + i as u64,
-            },
-            &mut |_| {},
-        ));
+        let run = run(session, &p.prompt, rounds, seed + i as u64)?;
         for s in &run.segments {
             if let (Some(b), Some(a)) = (s.score_before, s.score_after) {
                 before.push(b);
@@ -97,7 +98,7 @@ pub fn review_figures(
         log(&format!("review loop: {}/{} prompts", i + 1, prompts.len()));
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    ReviewFigures {
+    Ok(ReviewFigures {
         prompts: prompts.len(),
         segments: before.len(),
         rounds,
@@ -105,25 +106,16 @@ pub fn review_figures(
         mean_after: mean(&after),
         improved,
         kept_rounds: kept,
-    }
+    })
 }
 
 /// Plans and generates "a person walks in a circle clockwise" and measures the root path.
-pub fn circle_probe(model: &MotionModel, seed: u64) -> Option<CircleReport> {
-    let plan = offline::plan("a person walks in a circle clockwise", None);
-    let run = crate::executor::block_on(pipeline::run(
-        model,
-        None,
-        None::<&LlmClient<UreqTransport>>,
-        plan,
-        RunOptions { rounds: 0, seed },
-        &mut |_| {},
-    ));
-    let (features, notes) =
-        crate::executor::block_on(pipeline::motion_features(model, &run.plan, &run.tokens));
-    notes
+pub fn circle_probe(session: &Session, seed: u64) -> anyhow::Result<Option<CircleReport>> {
+    let run = run(session, "a person walks in a circle clockwise", 0, seed)?;
+    Ok(run
+        .path_notes
         .is_empty()
-        .then(|| circle_report(&root_path(&features), true))
+        .then(|| circle_report(&root_path(&run.motion.features), true)))
 }
 
 impl AgentFigures {

@@ -7,14 +7,15 @@
 //! - actions: "a person bows" must bend the trunk forward about as far as the dataset's bows
 //!   do, "a person waves the left hand" must move that hand about as much as its waves do.
 
+use crate::dataset::motions::MotionSet;
 use crate::executor::block_on;
-use crate::features::{FeatureFrame, FPS, POSITIONS};
+use crate::features::{FeatureFrame, POSITIONS};
 use crate::geom::{self, Vec3};
 use crate::model::generate::SamplingOptions;
 use crate::model::motion_model::sampling;
 use crate::model::MotionModel;
 use crate::skeleton::{joint, BodyPart, Pose};
-use crate::train::motions::MotionSet;
+use crate::timing::FPS;
 
 /// Result of the left/right probe.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -266,7 +267,7 @@ pub fn continuity(
     let b = block_on(model.generate(second, &[], 100, seed + 1));
     let joined = block_on(model.spam.blend(&a, &b, &ta, &tb, 2, &sampling(seed + 2)));
     let poses = block_on(model.joints(&joined));
-    let join = a[0][0].len() * crate::model::vq::DOWNSAMPLE;
+    let join = a[0][0].len() * crate::timing::FRAMES_PER_TOKEN;
     let speeds = frame_speeds(&poses);
     let near = &speeds[join.saturating_sub(2).min(speeds.len())..(join + 2).min(speeds.len())];
     let all: Vec<(f64, f64)> = reference.iter().flat_map(|m| frame_speeds(m)).collect();

@@ -3,21 +3,21 @@
 //! captions, the evaluator embeds texts and motions, and the field's metrics are computed,
 //! repeated with fresh caption draws and seeds to give a mean and a 95 % interval per figure.
 
-use super::evaluator::{Evaluator, EvaluatorConfig};
 use super::metrics::{diversity, fid, mm_dist, multimodality, r_precision, Interval};
 use super::probes::foot_skating;
-use crate::agents::llm::{LlmClient, UreqTransport};
-use crate::agents::pipeline::{self, RunOptions};
-use crate::agents::plan::{PartEdits, Plan, PlannerKind, Segment};
-use crate::agents::reviewer::Scorer;
+use crate::agents::llm::UreqTransport;
+use crate::dataset::motions::MotionSet;
 use crate::executor::block_on;
-use crate::features::{features_to_joints, FeatureFrame, FPS};
+use crate::features::{features_to_joints, FeatureFrame};
 use crate::model::edit::part_text;
+use crate::model::evaluator::{Evaluator, EvaluatorConfig};
 use crate::model::generate::SamplingOptions;
 use crate::model::transformer::TEXT_DIM;
 use crate::model::Spam;
+use crate::plan::{PartEdits, Plan, PlannerKind, Segment};
 use crate::rng::Rng;
-use crate::train::motions::MotionSet;
+use crate::session::{Command, Llm, Outcome, Session};
+use crate::timing::FPS;
 use anyhow::Result;
 use burn::prelude::*;
 use std::collections::{BTreeMap, HashMap};
@@ -125,21 +125,22 @@ pub enum Source<'a> {
     /// SPAM, generating a motion of the test motion's length from the caption.
     Spam(&'a Spam),
     /// The same, then reviewed for up to `rounds` rounds by the loop of
-    /// [`crate::agents::pipeline`] with the evaluator as judge (no LLM): the caption is one
+    /// the engine ([`crate::session`]) with the evaluator as judge (no LLM): the caption is one
     /// segment. No multimodality (it would cost ten reviewed motions a caption). A reviewed
     /// motion costs several generations, so the row may be measured on only the first
     /// `repeats` repetitions (same motions per repetition as every other row, so its FID
     /// compares).
     ReviewedSpam {
-        scorer: &'a Scorer<'a>,
+        session: &'a Session,
         rounds: usize,
         repeats: usize,
     },
 }
 
-/// The motion the review loop makes of one caption, `frames` long (at most 196).
+/// The motion (normalised features) the engine's review loop makes of one caption, `frames`
+/// long (at most 196).
 fn reviewed(
-    scorer: &Scorer,
+    session: &Session,
     caption: &str,
     frames: usize,
     rounds: usize,
@@ -159,17 +160,21 @@ fn reviewed(
         planner: PlannerKind::Offline,
         notes: Vec::new(),
     };
+    let command = Command::Run {
+        prompt: caption.to_string(),
+        seed,
+        rounds,
+        seconds: None,
+        plan: Some(plan),
+    };
     block_on(async {
-        let run = pipeline::run(
-            scorer.model,
-            Some(scorer),
-            None::<&LlmClient<UreqTransport>>,
-            plan,
-            RunOptions { rounds, seed },
-            &mut |_| {},
-        )
-        .await;
-        scorer.model.spam.decode(&run.tokens).await
+        let outcome = session
+            .execute(command, &Llm::<UreqTransport>::Off, &mut |_| {})
+            .await;
+        let Ok(Outcome::Run(run)) = outcome else {
+            unreachable!("a run of a valid plan answers with its motion: {outcome:?}")
+        };
+        session.model().spam.decode(&run.motion.tokens).await
     })
 }
 
@@ -317,13 +322,15 @@ impl Protocol<'_> {
                             &mut rng,
                         ));
                     }
-                    Source::ReviewedSpam { scorer, rounds, .. } => {
+                    Source::ReviewedSpam {
+                        session, rounds, ..
+                    } => {
                         generated = captions
                             .iter()
                             .enumerate()
                             .map(|(k, c)| {
                                 let frames = self.test.items[order[k]].features.len().min(196);
-                                reviewed(scorer, c, frames, *rounds, (repeat * 100_000 + k) as u64)
+                                reviewed(session, c, frames, *rounds, (repeat * 100_000 + k) as u64)
                             })
                             .collect();
                         features = generated.iter().map(Vec::as_slice).collect();

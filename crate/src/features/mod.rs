@@ -22,8 +22,6 @@ pub mod check;
 
 /// Floats per frame.
 pub const FEATURE_DIM: usize = 263;
-/// Frames per second of every motion in the product.
-pub const FPS: f64 = 20.0;
 /// Root angular velocity (column 0).
 pub const ROOT_ROT_VEL: Range<usize> = 0..1;
 /// Root linear velocity on the ground plane (columns 1, 2).

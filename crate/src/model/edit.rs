@@ -11,11 +11,11 @@
 
 use super::generate::{KeepResidual, MotionTokens, SamplingOptions};
 use super::transformer::{PARTS, TEXT_DIM};
-use super::vq::DOWNSAMPLE;
 use super::Spam;
 use crate::features::{FeatureFrame, FEATURE_DIM};
 use crate::rng::Rng;
 use crate::skeleton::BodyPart;
+use crate::timing::FRAMES_PER_TOKEN;
 use burn::prelude::*;
 use burn::tensor::{Int, TensorData};
 
@@ -35,7 +35,7 @@ pub fn part_text(global: &[f32; TEXT_DIM], overrides: &[(BodyPart, [f32; TEXT_DI
 
 /// Time steps (of 4 frames) needed for `frames` frames, within the model's range.
 pub fn steps_for_frames(frames: usize, max_steps: usize) -> usize {
-    (frames.div_ceil(DOWNSAMPLE)).clamp(1, max_steps)
+    (frames.div_ceil(FRAMES_PER_TOKEN)).clamp(1, max_steps)
 }
 
 impl Spam {
@@ -102,7 +102,10 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = tokens[0][0].len();
-        let (a, b) = (from / DOWNSAMPLE, to.div_ceil(DOWNSAMPLE).min(n));
+        let (a, b) = (
+            from / FRAMES_PER_TOKEN,
+            to.div_ceil(FRAMES_PER_TOKEN).min(n),
+        );
         let editable: Vec<Vec<bool>> = (0..PARTS)
             .map(|_| (0..n).map(|s| s >= a && s < b).collect())
             .collect();
@@ -136,11 +139,7 @@ impl Spam {
             }
         });
         let donor = self.generate_steps(&donor_text, n, options).await;
-        let mut edited = tokens.clone();
-        for p in chosen {
-            edited[p] = donor[p].clone();
-        }
-        edited
+        tokens.with_parts_from(&donor, &chosen)
     }
 
     /// Joins `a` then `b`: the last `overlap` steps of `a` and the first `overlap` of `b` are
@@ -162,19 +161,21 @@ impl Spam {
         let start_a = na.saturating_sub(ov_a + context);
         let end_b = (ov_b + context).min(nb);
         let layers = a[0].len();
-        let joined: MotionTokens = (0..PARTS)
-            .map(|p| {
-                (0..layers)
-                    .map(|l| {
-                        a[p][l][start_a..]
-                            .iter()
-                            .chain(&b[p][l][..end_b])
-                            .copied()
-                            .collect()
-                    })
-                    .collect()
-            })
-            .collect();
+        let joined = MotionTokens::from_model(
+            (0..PARTS)
+                .map(|p| {
+                    (0..layers)
+                        .map(|l| {
+                            a[p][l][start_a..]
+                                .iter()
+                                .chain(&b[p][l][..end_b])
+                                .copied()
+                                .collect()
+                        })
+                        .collect()
+                })
+                .collect(),
+        );
         let w = joined[0][0].len();
         let (mask_from, mask_to) = (na - start_a - ov_a, na - start_a + ov_b);
         let editable: Vec<Vec<bool>> = (0..PARTS)
@@ -187,7 +188,7 @@ impl Spam {
             v
         });
         let window = self.fill(&text, Some(&joined), &editable, options).await;
-        (0..PARTS)
+        let grid = (0..PARTS)
             .map(|p| {
                 (0..layers)
                     .map(|l| {
@@ -198,12 +199,13 @@ impl Spam {
                     })
                     .collect()
             })
-            .collect()
+            .collect();
+        MotionTokens::from_model(grid)
     }
 
     /// Tokens of normalised features (cut to a multiple of 4 frames).
     pub fn tokenize(&self, features: &[FeatureFrame]) -> MotionTokens {
-        self.vq.tokenize_motion(features, &self.device)
+        MotionTokens::from_model(self.vq.tokenize_motion(features, &self.device))
     }
 
     /// Normalised features of tokens (`4 × steps` frames).

@@ -37,8 +37,7 @@ impl Default for SamplingOptions {
     }
 }
 
-/// Tokens of one motion: `[part][layer][step]`.
-pub type MotionTokens = Vec<Vec<Vec<u32>>>;
+pub use super::tokens::MotionTokens;
 
 /// Fraction of tokens still masked at progress `t` ∈ [0, 1] (1 at the start, 0 at the end).
 pub fn mask_schedule(t: f64) -> f64 {
@@ -190,13 +189,13 @@ impl Spam {
         options: &SamplingOptions,
         rng: &mut Rng,
     ) -> MotionTokens {
-        let mut layers: MotionTokens = base.into_iter().map(|b| vec![b]).collect();
+        let mut layers: Vec<Vec<Vec<u32>>> = base.into_iter().map(|b| vec![b]).collect();
         let Some(Residual {
             network: model,
             config,
         }) = &self.residual
         else {
-            return layers;
+            return MotionTokens::from_model(layers);
         };
         let device = &self.device;
         let n = layers[0][0].len();
@@ -232,7 +231,7 @@ impl Spam {
                 part.push(row);
             }
         }
-        layers
+        MotionTokens::from_model(layers)
     }
 }
 

@@ -1,10 +1,13 @@
 //! SPAM, the body-part-aware motion generator: the residual VQ-VAE ([`vq`]), the masked
 //! transformers that generate its tokens from text ([`transformer`]), sampling
-//! ([`generate`]) and editing ([`edit`]).
+//! ([`generate`]) and editing ([`edit`]); beside it the text–motion evaluator ([`evaluator`]),
+//! the network that measures motions and judges them for the reviewer.
 
 pub mod edit;
+pub mod evaluator;
 pub mod generate;
 pub mod motion_model;
+pub mod tokens;
 pub mod transformer;
 pub mod vq;
 

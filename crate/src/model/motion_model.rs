@@ -5,13 +5,11 @@
 use super::edit::{part_text, PartText};
 use super::generate::{MotionTokens, SamplingOptions};
 use super::{Spam, SpamFiles, SpamLoadError};
-use crate::features::{features_to_joints, Features, Normalizer, FPS};
+use crate::features::{features_to_joints, Features, Normalizer};
 use crate::skeleton::{BodyPart, Pose};
 use crate::text::minilm::{MiniLmError, SentenceEncoder};
+use crate::timing::{FRAMES_PER_TOKEN, MAX_FRAMES};
 use burn::prelude::*;
-
-/// Longest motion one generation makes: 196 frames, 9.8 s at 20 fps.
-pub const MAX_FRAMES: usize = 196;
 
 /// Why a motion model could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -85,7 +83,7 @@ impl MotionModel {
         part_text(&embed(prompt), &overrides)
     }
 
-    /// A new motion of about `frames` frames (4 to [`MAX_FRAMES`], in steps of 4).
+    /// A new motion of about `frames` frames ([`FRAMES_PER_TOKEN`] to [`MAX_FRAMES`], in whole token steps).
     pub async fn generate(
         &self,
         prompt: &str,
@@ -108,7 +106,7 @@ impl MotionModel {
         self.spam
             .generate(
                 &self.condition(prompt, parts),
-                frames.clamp(4, MAX_FRAMES),
+                frames.clamp(FRAMES_PER_TOKEN, MAX_FRAMES),
                 options,
             )
             .await
@@ -174,14 +172,5 @@ pub fn sampling(seed: u64) -> SamplingOptions {
     SamplingOptions {
         seed,
         ..Default::default()
-    }
-}
-
-/// Frames for a length in seconds, within what one generation makes.
-pub fn frames_for_seconds(seconds: f64) -> usize {
-    if seconds.is_finite() {
-        ((seconds * FPS).round().max(4.0) as usize).min(MAX_FRAMES)
-    } else {
-        MAX_FRAMES
     }
 }

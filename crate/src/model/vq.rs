@@ -23,8 +23,7 @@ use burn::prelude::*;
 use burn::tensor::activation::relu;
 use burn::tensor::{Distribution, Int, TensorData};
 
-/// Temporal downsampling of the encoders: one token per 4 frames (0.2 s).
-pub const DOWNSAMPLE: usize = 4;
+use crate::timing::FRAMES_PER_TOKEN;
 
 /// Sizes and training constants of the VQ-VAE.
 #[derive(Config, Debug)]
@@ -482,7 +481,7 @@ impl MotionVq {
         features: &[crate::features::FeatureFrame],
         device: &Device,
     ) -> Vec<Vec<Vec<u32>>> {
-        let t = (features.len() / DOWNSAMPLE * DOWNSAMPLE).max(DOWNSAMPLE);
+        let t = (features.len() / FRAMES_PER_TOKEN * FRAMES_PER_TOKEN).max(FRAMES_PER_TOKEN);
         let mut flat: Vec<f32> = features.iter().take(t).flatten().copied().collect();
         flat.resize(t * FEATURE_DIM, 0.0);
         let x = Tensor::<3>::from_data(TensorData::new(flat, [1, t, FEATURE_DIM]), device);

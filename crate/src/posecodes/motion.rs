@@ -4,9 +4,9 @@ use super::frame::{
     self, ArmCodes, ArmJoints, BodyFrame, FrameCodes, LegCodes, LegJoints, Vertical, LEFT_ARM,
     LEFT_LEG, RIGHT_ARM, RIGHT_LEG,
 };
-use crate::features::FPS;
 use crate::geom::{self, Vec3};
 use crate::skeleton::{joint, Pose};
+use crate::timing::FPS;
 use serde::Serialize;
 
 /// Below this root speed on the ground (m/s) the body is "still". Set above the drift of a

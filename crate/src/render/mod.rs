@@ -27,8 +27,7 @@ use tiny_skia::{
 use crate::geom::{self, Vec3};
 use crate::skeleton::{joint, BodyPart, Pose, JOINT_NAMES, PARENTS};
 
-/// Frames per second of every motion.
-const FPS: f64 = 20.0;
+use crate::timing::FPS;
 
 /// Colour of each limb (sRGB). Warm colours are on the character's left and cool ones on its
 /// right, so sides can be told apart at a glance even where the colours are hard to name.

@@ -8,7 +8,7 @@
 //!  model id                       8 bytes (the hash of the weights that made the tokens)
 //!  seed                           varint
 //!  prompt, plan, record           varint length + UTF-8 each (plan and record as JSON, may
-//!                                   be empty)
+//!                                   be empty; read into types by [`record`])
 //!  edits                          varint count, then per edit:
 //!                                   kind u8, text, from and to frame (varints),
 //!                                   body-part mask u8 (bit p = part p), seed varint
@@ -22,10 +22,15 @@
 //! Decoding never panics on any input and caps every size before it allocates, so a hostile
 //! link costs at most a few hundred kilobytes and a clear error.
 
-mod base64url;
+pub mod record;
 
-use crate::model::generate::MotionTokens;
+use crate::model::tokens::{MotionTokens, MAX_LAYERS, MAX_STEPS};
+use base64::Engine;
+pub use record::{LinkPlan, LinkSegment, RunRecord, SegmentScores};
 use serde::{Deserialize, Serialize};
+
+/// base64url without padding (RFC 4648 §5): the alphabet that survives in a URL fragment.
+const BASE64: base64::engine::GeneralPurpose = base64::engine::general_purpose::URL_SAFE_NO_PAD;
 
 /// The payload version this code writes.
 pub const VERSION: u8 = 2;
@@ -42,12 +47,6 @@ pub const MAX_TEXT: usize = 4 * 1024;
 pub const MAX_PLAN: usize = 64 * 1024;
 /// Most edits in a history.
 pub const MAX_EDITS: usize = 256;
-/// Most quantizer layers and time steps of a token grid (196 frames are 49 steps; a blend of
-/// four segments is at most 4 × 49).
-pub const MAX_LAYERS: usize = 8;
-pub const MAX_STEPS: usize = 4 * 50;
-/// Codes are 9 bits.
-pub const MAX_CODE: u32 = 511;
 
 /// What a step of the history did. (Serde only for the page's worker messages; links use the
 /// byte layout above.)
@@ -97,20 +96,23 @@ pub struct Edit {
 }
 
 /// Everything a link carries.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SharedMotion {
     /// Id of the weights (first 8 bytes of their hash, see `model::model_id`).
     pub model_id: [u8; 8],
     pub seed: u64,
     pub prompt: String,
-    /// The plan as JSON ("" when there was none).
-    pub plan: String,
-    /// How the run went, as JSON the page writes and reads (its step lines, the review's
-    /// scores per segment, its notes); "" when there is none. Opaque here.
-    pub record: String,
+    /// The plan the motion followed.
+    pub plan: LinkPlan,
+    /// How the run that made the motion went (its step lines, the review's scores per
+    /// segment, its notes), when a run made it.
+    pub record: Option<RunRecord>,
     pub history: Vec<Edit>,
     /// Final tokens `[part][layer][step]`.
     pub tokens: MotionTokens,
+    /// What the decoder could not read and dropped (a plan or record that does not read), for
+    /// the user; never written into a link.
+    pub notes: Vec<String>,
 }
 
 /// Why a link could not be opened.
@@ -169,11 +171,11 @@ fn put_text(out: &mut Vec<u8>, s: &str) {
 }
 
 /// Encodes a motion as a link fragment (`m=…`, without the `#`). Texts longer than the
-/// decoder accepts are cut at a character boundary, and codes above 511 are clamped, so
-/// whatever this writes, [`decode`] reads back.
+/// decoder accepts are cut at a character boundary, so whatever this writes, [`decode`] reads
+/// back.
 pub fn encode(motion: &SharedMotion) -> String {
     let packed = miniz_oxide::deflate::compress_to_vec(&payload(motion), 9);
-    format!("m={}", base64url::encode(&packed))
+    format!("m={}", BASE64.encode(packed))
 }
 
 /// The uncompressed payload of a motion.
@@ -184,8 +186,11 @@ fn payload(motion: &SharedMotion) -> Vec<u8> {
     out.extend_from_slice(&motion.model_id);
     put_varint(&mut out, motion.seed);
     put_text(&mut out, truncate(&motion.prompt, MAX_TEXT));
-    put_text(&mut out, truncate(&motion.plan, MAX_PLAN));
-    put_text(&mut out, truncate(&motion.record, MAX_PLAN));
+    put_text(&mut out, truncate(&motion.plan.to_json(), MAX_PLAN));
+    put_text(
+        &mut out,
+        truncate(&record::record_to_json(&motion.record), MAX_PLAN),
+    );
     let edits = &motion.history[..motion.history.len().min(MAX_EDITS)];
     put_varint(&mut out, edits.len() as u64);
     for e in edits {
@@ -196,28 +201,14 @@ fn payload(motion: &SharedMotion) -> Vec<u8> {
         out.push(e.parts & 0x0f);
         put_varint(&mut out, e.seed);
     }
-    let parts = motion.tokens.len().min(4);
-    let layers = motion.tokens.first().map_or(0, |p| p.len().min(MAX_LAYERS));
-    let steps = motion
-        .tokens
-        .first()
-        .and_then(|p| p.first())
-        .map_or(0, |l| l.len().min(MAX_STEPS));
-    out.push(parts as u8);
-    out.push(layers as u8);
-    put_varint(&mut out, steps as u64);
+    // Checked tokens: 4 parts, 1 to MAX_LAYERS layers, 1 to MAX_STEPS steps, 9-bit codes.
+    let tokens = &motion.tokens;
+    out.push(tokens.len() as u8);
+    out.push(tokens.layers() as u8);
+    put_varint(&mut out, tokens.steps() as u64);
     let mut bits = BitWriter::default();
-    for p in 0..parts {
-        for l in 0..layers {
-            for s in 0..steps {
-                let code = motion.tokens[p]
-                    .get(l)
-                    .and_then(|row| row.get(s))
-                    .copied()
-                    .unwrap_or(0);
-                bits.put(code.min(MAX_CODE));
-            }
-        }
+    for code in tokens.iter().flatten().flatten() {
+        bits.put(*code);
     }
     out.extend(bits.finish());
     out
@@ -327,7 +318,7 @@ pub fn decode(link: &str) -> Result<SharedMotion, LinkError> {
     if value.len() > MAX_LINK_CHARS {
         return Err(LinkError::TooLong);
     }
-    let packed = base64url::decode(value).ok_or(LinkError::BadEncoding)?;
+    let packed = BASE64.decode(value).map_err(|_| LinkError::BadEncoding)?;
     let payload = miniz_oxide::inflate::decompress_to_vec_with_limit(&packed, MAX_PAYLOAD)
         .map_err(|e| LinkError::BadCompression(format!("{:?}", e.status)))?;
     parse_payload(&payload)
@@ -356,6 +347,7 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
     } else {
         r.text(MAX_PLAN, "run record")?
     };
+    let mut notes = Vec::new();
     let count = r.bounded(MAX_EDITS as u64, "the number of edits")?;
     let mut history = Vec::with_capacity(count);
     for _ in 0..count {
@@ -419,13 +411,30 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
         ));
     }
     let mut it = codes.into_iter();
-    let tokens = (0..parts)
-        .map(|_| {
-            (0..layers)
-                .map(|_| it.by_ref().take(steps).collect())
-                .collect()
-        })
-        .collect();
+    let tokens = MotionTokens::new(
+        (0..parts)
+            .map(|_| {
+                (0..layers)
+                    .map(|_| it.by_ref().take(steps).collect())
+                    .collect()
+            })
+            .collect(),
+    )
+    .map_err(|e| LinkError::Invalid(e.to_string()))?;
+    let plan = LinkPlan::from_json(&plan, tokens.frames()).unwrap_or_else(|e| {
+        notes.push(format!(
+            "the link's plan does not read ({e}), so the motion shows without its segments' \
+             plans and paths"
+        ));
+        LinkPlan::None
+    });
+    let record = record::record_from_json(&record).unwrap_or_else(|e| {
+        notes.push(format!(
+            "the link's record of its run does not read ({e}), so its steps and review \
+             scores are not shown"
+        ));
+        None
+    });
     Ok(SharedMotion {
         model_id,
         seed,
@@ -434,6 +443,7 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
         record,
         history,
         tokens,
+        notes,
     })
 }
 

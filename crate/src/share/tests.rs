@@ -7,8 +7,19 @@ fn sample(steps: usize) -> SharedMotion {
         model_id: model_id_bytes("0123456789abcdef").unwrap(),
         seed: 42,
         prompt: "a person walks forward waving the left hand, then bows — «politely»".into(),
-        plan: r#"{"segments":[{"text":"walk forward","seconds":4.0}]}"#.into(),
-        record: r#"{"steps":["segment 1: generated"],"scores":[{"before":31.5}]}"#.into(),
+        plan: LinkPlan::Segments(vec![LinkSegment {
+            text: "walk forward".into(),
+            from: 0,
+            to: steps.min(2) * 4,
+        }]),
+        record: Some(RunRecord {
+            steps: vec!["segment 1: generated".into()],
+            scores: vec![SegmentScores {
+                before: Some(31.5),
+                ..Default::default()
+            }],
+            notes: Vec::new(),
+        }),
         history: vec![
             Edit {
                 kind: EditKind::Generate,
@@ -27,13 +38,17 @@ fn sample(steps: usize) -> SharedMotion {
                 seed: u64::MAX,
             },
         ],
-        tokens: (0..4)
-            .map(|_| {
-                (0..4)
-                    .map(|_| (0..steps).map(|_| rng.below(512) as u32).collect())
-                    .collect()
-            })
-            .collect(),
+        tokens: MotionTokens::new(
+            (0..4)
+                .map(|_| {
+                    (0..4)
+                        .map(|_| (0..steps).map(|_| rng.below(512) as u32).collect())
+                        .collect()
+                })
+                .collect(),
+        )
+        .unwrap(),
+        notes: Vec::new(),
     }
 }
 
@@ -67,10 +82,44 @@ fn tokens_are_packed_in_nine_bits() {
 fn oversized_fields_are_cut_so_the_link_still_opens() {
     let mut motion = sample(3);
     motion.prompt = "é".repeat(MAX_TEXT);
-    motion.tokens[0][0][0] = 100_000;
     let back = decode(&encode(&motion)).unwrap();
     assert!(back.prompt.len() <= MAX_TEXT && back.prompt.chars().all(|c| c == 'é'));
-    assert_eq!(back.tokens[0][0][0], MAX_CODE);
+}
+
+#[test]
+fn a_plan_or_record_that_does_not_read_leaves_a_note_and_the_motion_opens_whole() {
+    let motion = sample(10);
+    let raw = |plan: &str, record: &str| {
+        let mut p = payload(&SharedMotion {
+            plan: LinkPlan::None,
+            record: None,
+            ..motion.clone()
+        });
+        // The plan's and the record's empty lengths sit right after the prompt.
+        let at = 3 + 8 + 1 + 1 + motion.prompt.len();
+        assert_eq!(&p[at..at + 2], &[0, 0]);
+        let mut texts = Vec::new();
+        put_text(&mut texts, plan);
+        put_text(&mut texts, record);
+        p.splice(at..at + 2, texts);
+        parse_payload(&p).unwrap()
+    };
+    let opened = raw(
+        r#"{"segments":[{"text":"walk","from":0,"to":4000}]}"#,
+        "[1]",
+    );
+    assert_eq!(opened.tokens, motion.tokens);
+    assert_eq!((&opened.plan, &opened.record), (&LinkPlan::None, &None));
+    assert_eq!(opened.notes.len(), 2, "{:?}", opened.notes);
+    assert!(opened.notes[0].contains("plan does not read"));
+    assert!(opened.notes[1].contains("record of its run does not read"));
+    // An older link's segments, and a planner's plan, read as such.
+    let older = raw(r#"{"segments":[{"text":"walk","from":0,"to":40}]}"#, "");
+    assert!(matches!(&older.plan, LinkPlan::Segments(s) if s[0].to == 40));
+    let plan = crate::agents::planner::offline::plan("a person walks forward", None);
+    let planned = raw(&serde_json::to_string(&plan).unwrap(), "");
+    assert_eq!(planned.plan.plan(), Some(&plan));
+    assert!(planned.notes.is_empty());
 }
 
 #[test]
@@ -80,7 +129,7 @@ fn broken_links_give_clear_errors() {
     let link = |payload: &[u8]| {
         format!(
             "m={}",
-            base64url::encode(&miniz_oxide::deflate::compress_to_vec(payload, 6))
+            BASE64.encode(miniz_oxide::deflate::compress_to_vec(payload, 6))
         )
     };
     let mut future = payload(&sample(10));
@@ -130,9 +179,10 @@ fn broken_links_give_clear_errors() {
 fn links_of_the_first_version_still_open() {
     // Version 1 is version 2 without the record: cut the record out of a version 2 payload.
     let mut motion = sample(7);
-    motion.record = String::new();
+    motion.record = None;
     let v2 = payload(&motion);
-    let record_at = 3 + 8 + 1 + (1 + motion.prompt.len()) + (1 + motion.plan.len());
+    let plan = motion.plan.to_json();
+    let record_at = 3 + 8 + 1 + (1 + motion.prompt.len()) + (1 + plan.len());
     assert_eq!(v2[record_at], 0, "an empty record is one zero length byte");
     let mut v1 = v2.clone();
     v1.remove(record_at);
@@ -201,7 +251,7 @@ fn the_decoder_survives_a_million_random_and_mutated_links() {
                 mutate(&mut p, &mut rng);
                 decode(&format!(
                     "m={}",
-                    base64url::encode(&miniz_oxide::deflate::compress_to_vec(&p, 1))
+                    BASE64.encode(miniz_oxide::deflate::compress_to_vec(&p, 1))
                 ))
             }
             // Mutated link text.

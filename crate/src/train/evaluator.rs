@@ -3,11 +3,11 @@
 //! other's negatives (the dataset's captions come from labels, so many motions share a
 //! sentence), validated by top-3 R-precision on the validation split.
 
-use super::motions::MotionSet;
 use super::run::Run;
-use crate::eval::evaluator::{motion_batch, Evaluator, EvaluatorConfig};
+use crate::dataset::motions::MotionSet;
 use crate::eval::metrics::r_precision;
 use crate::features::FeatureFrame;
+use crate::model::evaluator::{motion_batch, Evaluator, EvaluatorConfig};
 use crate::model::transformer::TEXT_DIM;
 use crate::rng::Rng;
 use anyhow::Result;

@@ -1,8 +1,8 @@
-//! Training: the data in memory, run bookkeeping (checkpoints, logs, plots) and the training
+//! Training: run bookkeeping (checkpoints, logs, plots) and the training
 //! loops of the motion model.
 
 pub mod evaluator;
-pub mod motions;
+pub mod launch;
 pub mod run;
 pub mod tokens;
 pub mod transformer;

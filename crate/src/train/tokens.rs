@@ -1,7 +1,7 @@
 //! The training data of the transformers: every training motion as VQ tokens, with the
 //! sentence embeddings of its captions and per-part sentences, and masked batches of it.
 
-use super::motions::MotionSet;
+use crate::dataset::motions::MotionSet;
 use crate::model::transformer::{TransformerConfig, PARTS, TEXT_DIM};
 use crate::model::vq::MotionVq;
 use crate::rng::Rng;

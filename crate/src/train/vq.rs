@@ -3,13 +3,14 @@
 //! moving-average codebooks, resumable checkpoints, and the reconstruction error in millimetres
 //! on held-out motions.
 
-use super::motions::MotionSet;
 use super::run::Run;
+use crate::dataset::motions::MotionSet;
 use crate::dataset::Split;
 use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM, POSITIONS};
 use crate::geom;
-use crate::model::vq::{MotionVq, VqConfig, DOWNSAMPLE};
+use crate::model::vq::{MotionVq, VqConfig};
 use crate::rng::Rng;
+use crate::timing::FRAMES_PER_TOKEN;
 use anyhow::{Context, Result};
 use burn::grad_clipping::GradientClippingConfig;
 use burn::nn::loss::SmoothL1LossConfig;
@@ -131,7 +132,12 @@ pub fn train_vq(
         // Each step's randomness depends only on the seed and the step, so a resumed run
         // continues exactly as an uninterrupted one would.
         let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        let crops = train.sample_crops(&mut rng, config.batch_size, config.max_frames, DOWNSAMPLE);
+        let crops = train.sample_crops(
+            &mut rng,
+            config.batch_size,
+            config.max_frames,
+            FRAMES_PER_TOKEN,
+        );
         let x = batch_tensor(crops.data, crops.batch, crops.frames, device);
 
         let out = model.forward_train(x.clone(), &config.model, &mut rng);
@@ -234,7 +240,7 @@ pub fn reconstruction_errors(
 ) -> Result<ReconstructionError> {
     let (mut global, mut aligned, mut count, mut motions) = (0.0, 0.0, 0usize, 0usize);
     for item in set.items.iter().take(limit) {
-        let t = item.features.len() / DOWNSAMPLE * DOWNSAMPLE;
+        let t = item.features.len() / FRAMES_PER_TOKEN * FRAMES_PER_TOKEN;
         if t == 0 {
             continue;
         }

@@ -8,7 +8,7 @@ use serde::Serialize;
 const MIN_STEP_M: f64 = 1e-3;
 
 /// How well a ground path (x, z in metres, Y up) matches a circle.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct CircleReport {
     /// Distance from the last point back to the first, metres.
     pub closure_error_m: f64,

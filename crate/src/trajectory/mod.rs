@@ -110,9 +110,10 @@ pub fn apply(
 /// Synthetic motions shared by the tests of the submodules.
 #[cfg(test)]
 pub(crate) mod test_motion {
-    use crate::features::{Features, FEATURE_DIM, FPS, POSITIONS};
+    use crate::features::{Features, FEATURE_DIM, POSITIONS};
     use crate::geom::{self, Quat, Vec3};
     use crate::skeleton::{self, joint, Offsets, Pose, Rotations, NUM_JOINTS};
+    use crate::timing::FPS;
 
     /// A walk-like motion as joints: the root moves `step_m` per frame along its facing,
     /// which turns `yaw_per_frame` radians per frame (positive to the left), while legs and

@@ -38,9 +38,10 @@
 //! removes drift and sidestepping), faded in and out over the first and last half second so the
 //! path's ends are met exactly, and clamped to [`MapOptions::max_sway_m`].
 
-use crate::features::{FeatureFrame, Features, FPS, POSITIONS, VELOCITIES};
+use crate::features::{FeatureFrame, Features, POSITIONS, VELOCITIES};
 use crate::geom::{self, Quat, Vec3};
 use crate::skeleton::NUM_JOINTS;
+use crate::timing::FPS;
 
 use super::path::{self, ArcPath, PathError};
 use super::shapes::Curve;

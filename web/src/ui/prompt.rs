@@ -3,8 +3,8 @@
 //! review, blend.
 
 use crate::app::{AppState, Pending};
-use crate::messages::Request;
 use coma::agents::pipeline::DEFAULT_ROUNDS;
+use coma::session::Command;
 use leptos::prelude::*;
 
 /// Most review rounds offered: each round may regenerate every body part of every segment.
@@ -43,14 +43,14 @@ pub fn PromptBox() -> impl IntoView {
             None => "planning…".to_string(),
         });
         state.request(
-            Request::Run {
+            Command::Run {
                 prompt: text.clone(),
                 seed: s,
                 rounds: rounds.get_untracked(),
                 seconds: seconds.get_untracked(),
-                llm,
                 plan: None,
             },
+            llm,
             Pending::Run {
                 prompt: text,
                 seed: s,

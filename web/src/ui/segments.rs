@@ -4,8 +4,9 @@
 //! exists.
 
 use crate::app::{AppState, Pending};
-use crate::messages::{Request, SegmentScores};
 use crate::take::{plan_segments, Segment};
+use coma::session::Command;
+use coma::share::SegmentScores;
 use coma::share::{Edit, EditKind};
 use leptos::prelude::*;
 
@@ -58,14 +59,15 @@ fn regenerate(state: AppState, index: usize) {
     let seed = next_seed(&state);
     state.say("regenerating the segment…");
     state.request(
-        Request::InBetween {
+        Command::InBetween {
             tokens: take.motion.tokens.clone(),
             text: segment.text.clone(),
             from: segment.from,
             to: segment.to,
             seed,
-            plan: Some(take.plan_json()),
+            plan: take.plan.clone(),
         },
+        None,
         Pending::Edit(Edit {
             kind: EditKind::Regenerate,
             text: segment.text,

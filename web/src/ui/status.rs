@@ -2,8 +2,8 @@
 //! out and say what to do).
 
 use crate::app::{AppState, Pending};
-use crate::messages::Request;
 use coma::agents::pipeline::DEFAULT_ROUNDS;
+use coma::session::Command;
 use leptos::prelude::*;
 
 #[component]
@@ -14,18 +14,15 @@ pub fn StatusBar() -> impl IntoView {
     let regenerate = move |_| {
         if let Some(link) = state.foreign_link.get_untracked() {
             state.foreign_link.set(None);
-            let plan = crate::planning::parse_plan(&link.plan)
-                .ok()
-                .map(|_| link.plan.clone());
             state.request(
-                Request::Run {
+                Command::Run {
                     prompt: link.prompt.clone(),
                     seed: link.seed,
                     rounds: DEFAULT_ROUNDS,
                     seconds: None,
-                    llm: None,
-                    plan,
+                    plan: link.plan.plan().cloned(),
                 },
+                None,
                 Pending::Run {
                     prompt: link.prompt,
                     seed: link.seed,

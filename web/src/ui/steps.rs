@@ -5,7 +5,7 @@
 
 use crate::app::{AppState, Pending};
 use crate::take::edit_line;
-use coma::agents::plan::PlannerKind;
+use coma::plan::PlannerKind;
 use leptos::prelude::*;
 
 #[component]

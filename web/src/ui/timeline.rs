@@ -4,12 +4,12 @@
 
 use super::segments::{next_seed, shown_segments, PlanList, SegmentBar};
 use crate::app::{AppState, Pending};
-use crate::messages::Request;
+use coma::session::Command;
 use coma::share::{Edit, EditKind};
 use coma::skeleton::BodyPart;
 use leptos::prelude::*;
 
-const FPS: f64 = 20.0;
+use coma::timing::FPS;
 
 #[component]
 pub fn Timeline() -> impl IntoView {
@@ -40,14 +40,15 @@ pub fn Timeline() -> impl IntoView {
         let seed = next_seed(&state);
         state.say("editing the range…");
         state.request(
-            Request::InBetween {
+            Command::InBetween {
                 tokens: take.motion.tokens.clone(),
                 text: text.clone(),
                 from: a,
                 to: b,
                 seed,
-                plan: Some(take.plan_json()),
+                plan: take.plan.clone(),
             },
+            None,
             Pending::Edit(Edit {
                 kind: EditKind::InBetween,
                 text,
@@ -68,11 +69,11 @@ pub fn Timeline() -> impl IntoView {
         if !chosen.contains(&true) {
             return state.fail("Tick the body parts to edit first.");
         }
-        let names: Vec<String> = BodyPart::ALL
+        let names: Vec<BodyPart> = BodyPart::ALL
             .iter()
             .zip(chosen)
             .filter(|(_, c)| *c)
-            .map(|(p, _)| p.name().to_string())
+            .map(|(p, _)| *p)
             .collect();
         let mask = chosen
             .iter()
@@ -81,13 +82,14 @@ pub fn Timeline() -> impl IntoView {
         let seed = next_seed(&state);
         state.say("editing the body parts…");
         state.request(
-            Request::EditParts {
+            Command::EditParts {
                 tokens: take.motion.tokens.clone(),
                 text: text.clone(),
                 parts: names,
                 seed,
-                plan: Some(take.plan_json()),
+                plan: take.plan.clone(),
             },
+            None,
             Pending::Edit(Edit {
                 kind: EditKind::BodyParts,
                 text,

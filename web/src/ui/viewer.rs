@@ -12,7 +12,7 @@ use std::rc::Rc;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 
-const FPS: f64 = 20.0;
+use coma::timing::FPS;
 
 /// Draws the current frame and advances the playhead by `dt` seconds.
 fn tick(

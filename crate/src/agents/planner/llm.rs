@@ -9,10 +9,8 @@ use super::offline::{self, Embedder};
 use crate::agents::llm::{
     parse_json_content, LlmClient, LlmError, Message, ReplyFormat, Transport,
 };
-use crate::agents::plan::{
-    clamp_seconds, clean_text, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS,
-};
 use crate::dataset::Vocabulary;
+use crate::plan::{clamp_seconds, clean_text, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS};
 use crate::trajectory::{CurveSpec, Shape, Trajectory};
 use serde::Deserialize;
 use serde_json::{json, Value};

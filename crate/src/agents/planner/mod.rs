@@ -1,4 +1,4 @@
-//! The planner: a prompt becomes a [`Plan`](crate::agents::plan::Plan) of consecutive
+//! The planner: a prompt becomes a [`Plan`](crate::plan::Plan) of consecutive
 //! segments, each with a base motion, body-part edits and an optional path.
 //!
 //! With an LLM configured, three steps each ask it one question with a JSON schema (rewrite,

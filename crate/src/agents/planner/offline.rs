@@ -14,7 +14,7 @@
 //!    similarity when an embedder is given, and dropped otherwise, with a note either way.
 
 use super::lexicon::{self, Action, Direction, Side};
-use crate::agents::plan::{
+use crate::plan::{
     clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS, MAX_TEXT_CHARS,
 };
 use crate::skeleton::BodyPart;
@@ -79,8 +79,8 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
         }
     }
     if segments.is_empty() {
-        let fallback = crate::agents::plan::clean_text(prompt)
-            .unwrap_or_else(|_| "a person walks forward".into());
+        let fallback =
+            crate::plan::clean_text(prompt).unwrap_or_else(|_| "a person walks forward".into());
         let fallback: String = fallback.chars().take(MAX_TEXT_CHARS).collect();
         notes.push("no known movement in the prompt; the model gets the prompt as it is".into());
         segments.push(Segment {

@@ -1,7 +1,7 @@
 //! The committed prompt set (`eval/prompts.json`) and how well a planner reads its temporal
 //! structure.
 
-use crate::agents::plan::Plan;
+use crate::plan::Plan;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

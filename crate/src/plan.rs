@@ -92,8 +92,11 @@ pub enum PlannerKind {
     Llm { model: String },
 }
 
-/// A prompt turned into segments.
+/// A prompt turned into segments. A plan that arrives from outside the planner (a share link,
+/// a worker message, a file) is checked as it is read: 1 to [`MAX_SEGMENTS`] segments, each
+/// of finite length, clamped into what one generation makes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "PlanFields")]
 pub struct Plan {
     /// What the user typed.
     pub prompt: String,
@@ -108,10 +111,74 @@ pub struct Plan {
     pub notes: Vec<String>,
 }
 
+/// A plan as it is read, before [`Plan`]'s checks.
+#[derive(Deserialize)]
+struct PlanFields {
+    prompt: String,
+    rewritten: String,
+    segments: Vec<Segment>,
+    planner: PlannerKind,
+    #[serde(default)]
+    notes: Vec<String>,
+}
+
+impl TryFrom<PlanFields> for Plan {
+    type Error = String;
+
+    fn try_from(fields: PlanFields) -> Result<Plan, String> {
+        Plan {
+            prompt: fields.prompt,
+            rewritten: fields.rewritten,
+            segments: fields.segments,
+            planner: fields.planner,
+            notes: fields.notes,
+        }
+        .checked()
+    }
+}
+
 impl Plan {
     /// Total length in seconds, before blending shortens the joins.
     pub fn seconds(&self) -> f64 {
         self.segments.iter().map(|s| s.seconds).sum()
+    }
+
+    /// The plan if it has 1 to [`MAX_SEGMENTS`] segments of finite length, with every length
+    /// clamped into what one generation makes (the plan's author may not have clamped).
+    pub fn checked(mut self) -> Result<Plan, String> {
+        if self.segments.is_empty() || self.segments.len() > MAX_SEGMENTS {
+            return Err(format!(
+                "a plan has 1 to {MAX_SEGMENTS} segments, this one {}",
+                self.segments.len()
+            ));
+        }
+        for s in &mut self.segments {
+            s.seconds = clamp_seconds(s.seconds).ok_or("a segment has no length")?;
+        }
+        Ok(self)
+    }
+
+    /// Scales the segments' durations so the plan lasts about `seconds` in all (each segment
+    /// still within what one generation makes), keeping their proportions: the length the
+    /// user asks for overrides the planner's estimates, not its split. A length other than the
+    /// one asked for leaves a note.
+    pub fn fit_seconds(&mut self, seconds: f64) {
+        let planned = self.seconds();
+        if !seconds.is_finite() || seconds <= 0.0 || planned <= 0.0 {
+            return;
+        }
+        let factor = seconds / planned;
+        for s in &mut self.segments {
+            s.seconds = clamp_seconds(s.seconds * factor).unwrap_or(s.seconds);
+        }
+        let got = self.seconds();
+        if (got - seconds).abs() > 0.05 {
+            self.notes.push(format!(
+                "asked for {seconds:.1} s; {} segment(s) of {MIN_SEGMENT_SECONDS} to \
+                 {MAX_SEGMENT_SECONDS} s make {got:.1} s",
+                self.segments.len()
+            ));
+        }
     }
 }
 
@@ -149,4 +216,62 @@ pub fn clean_text(text: &str) -> Result<String, String> {
         ));
     }
     Ok(cleaned)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::agents::planner::offline;
+
+    #[test]
+    fn plans_from_outside_are_checked_as_they_are_read() {
+        let plan = offline::plan("a person walks forward, then bows", None);
+        let json = serde_json::to_string(&plan).unwrap();
+        assert_eq!(serde_json::from_str::<Plan>(&json).unwrap(), plan);
+        let mut long = plan.clone();
+        long.segments[0].seconds = 1e9;
+        let read: Plan = serde_json::from_str(&serde_json::to_string(&long).unwrap()).unwrap();
+        assert_eq!(read.segments[0].seconds, MAX_SEGMENT_SECONDS);
+        let mut empty = plan.clone();
+        empty.segments.clear();
+        let mut many = plan.clone();
+        many.segments = vec![plan.segments[0].clone(); MAX_SEGMENTS + 1];
+        for bad in [
+            String::new(),
+            "{".into(),
+            r#"{"segments":[{"text":"x","from":0,"to":4}]}"#.into(),
+            serde_json::to_string(&empty).unwrap(),
+            serde_json::to_string(&many).unwrap(),
+            json.replace("\"seconds\":", "\"seconds\":null,\"x\":"),
+        ] {
+            assert!(serde_json::from_str::<Plan>(&bad).is_err(), "{bad}");
+        }
+        let e = serde_json::from_str::<Plan>(&serde_json::to_string(&many).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("1 to 4 segments"), "{e}");
+    }
+
+    #[test]
+    fn the_seconds_asked_for_scale_the_plan() {
+        let mut one = offline::plan("a person walks forward", None);
+        one.fit_seconds(9.8);
+        assert_eq!(one.segments[0].seconds, 9.8);
+        let mut three = offline::plan(
+            "A person walks forward waving the left hand, then turns right and bows",
+            None,
+        );
+        assert_eq!(three.segments.len(), 3);
+        let before = three.notes.len();
+        three.fit_seconds(9.0);
+        assert!((three.seconds() - 9.0).abs() < 1e-9, "{}", three.seconds());
+        assert_eq!(three.notes.len(), before);
+        // Three segments cannot be shorter than 3 × 2 s; the plan says so.
+        three.fit_seconds(3.0);
+        assert_eq!(three.seconds(), 6.0);
+        assert!(three.notes.last().unwrap().contains("make 6.0 s"));
+        let planned = three.clone();
+        three.fit_seconds(f64::NAN);
+        assert_eq!(three, planned);
+    }
 }

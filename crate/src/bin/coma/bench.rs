@@ -1,0 +1,33 @@
+//! `coma bench`: load, generation and training speed on this machine.
+
+use crate::common::ModelArgs;
+use anyhow::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Measure random weights of this size (a spam.json, e.g. configs/paper.json) instead of
+    /// the default model.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Timed training steps per network.
+    #[arg(long, default_value_t = 3)]
+    train_steps: usize,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+pub fn run(args: BenchArgs) -> Result<()> {
+    use burn::config::Config;
+    let sizes = match args.config {
+        Some(path) => Some(
+            coma::model::SpamConfig::load(&path)
+                .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?,
+        ),
+        None => None,
+    };
+    let rows = coma::bench::run_bench(&args.model.models, sizes.as_ref(), args.train_steps)?;
+    print!("{}", coma::bench::table(&rows));
+    Ok(())
+}

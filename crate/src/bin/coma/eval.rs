@@ -1,0 +1,83 @@
+//! `coma eval`: the field's metrics, the control probes and the agents' figures, written to
+//! EVAL.md and eval.json.
+
+use crate::common::ModelArgs;
+use anyhow::{Context, Result};
+use clap::Args;
+use coma::eval::run::{evaluate, AgentEvalOptions, EvalOptions};
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct EvalArgs {
+    /// Folder with evaluator.json and evaluator.bpk.
+    #[arg(long, default_value = "static/models")]
+    evaluator: PathBuf,
+    #[arg(long, default_value = "data/bandai")]
+    data: PathBuf,
+    /// Repetitions (each with fresh captions and seeds).
+    #[arg(long, default_value_t = 10)]
+    repeats: usize,
+    /// Test motions per repetition (whole batches of 32).
+    #[arg(long, default_value_t = 1024)]
+    motions: usize,
+    /// Captions × samples for SPAM's multimodality.
+    #[arg(long, default_value_t = 32)]
+    multimodality_texts: usize,
+    #[arg(long, default_value_t = 10)]
+    multimodality_samples: usize,
+    /// Seeds per prompt of the left/right probe.
+    #[arg(long, default_value_t = 20)]
+    probe_seeds: u64,
+    /// Leave SPAM out (real and retrieval rows only).
+    #[arg(long)]
+    no_spam: bool,
+    /// Prompt set for the planner and the review loop.
+    #[arg(long, default_value = "eval/prompts.json")]
+    prompts: PathBuf,
+    /// Review rounds (K) of the review loop's measurements (the spam_review row and the
+    /// prompt set); 0 skips them.
+    #[arg(long, default_value_t = 2)]
+    review_rounds: usize,
+    /// Repetitions the spam_review row is measured on (the first ones; all if absent): a
+    /// reviewed motion costs several generations.
+    #[arg(long)]
+    review_repeats: Option<usize>,
+    #[arg(long, default_value = "EVAL.md")]
+    markdown: PathBuf,
+    #[arg(long, default_value = "eval.json")]
+    json: PathBuf,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+pub fn run(args: EvalArgs) -> Result<()> {
+    let command = std::env::args()
+        .skip(1)
+        .fold("coma".to_string(), |acc, a| acc + " " + &a);
+    let options = EvalOptions {
+        evaluator: &args.evaluator,
+        data: &args.data,
+        spam: (!args.no_spam).then_some(args.model.models.as_path()),
+        protocol: coma::eval::protocol::ProtocolOptions {
+            repeats: args.repeats,
+            motions: args.motions,
+            multimodality_texts: args.multimodality_texts,
+            multimodality_samples: args.multimodality_samples,
+            ..Default::default()
+        },
+        probe_seeds: args.probe_seeds,
+        agents: AgentEvalOptions {
+            prompts: args.prompts,
+            review_rounds: args.review_rounds,
+            review_repeats: args.review_repeats.unwrap_or(args.repeats),
+        },
+        command,
+    };
+    let report = evaluate(&options, &|l| eprintln!("{l}"))?;
+    let (markdown, json) = (&args.markdown, &args.json);
+    std::fs::write(markdown, report.markdown())
+        .with_context(|| format!("writing {}", markdown.display()))?;
+    std::fs::write(json, report.json()).with_context(|| format!("writing {}", json.display()))?;
+    print!("{}", report.markdown());
+    Ok(())
+}

@@ -1,0 +1,133 @@
+//! `coma export`: trained runs assembled into a model folder, and what rounding them to f16
+//! changes.
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use coma::export::{self, EvaluatorRounding};
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct ExportArgs {
+    /// What to export: the three SPAM networks, the evaluator or the vocabulary.
+    #[arg(value_enum, default_value_t = ExportWhat::Spam)]
+    what: ExportWhat,
+    /// Evaluator run folder (with evaluator.bpk and config.json).
+    #[arg(long, default_value = "runs/evaluator")]
+    evaluator: PathBuf,
+    /// VQ-VAE run folder (with vq.bpk and config.json).
+    #[arg(long, default_value = "runs/vq")]
+    vq: PathBuf,
+    /// Base transformer run folder.
+    #[arg(long, default_value = "runs/base")]
+    base: PathBuf,
+    /// Residual transformer run folder; without it the model is base-only (its motions
+    /// decode from the layer-0 tokens alone).
+    #[arg(long)]
+    res: Option<PathBuf>,
+    /// Dataset whose Mean.npy/Std.npy normalised the training data (for the evaluator:
+    /// whose test split shows what rounding to f16 changes).
+    #[arg(long, default_value = "data/bandai")]
+    data: PathBuf,
+    #[arg(long, default_value = "static/models")]
+    out: PathBuf,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ExportWhat {
+    /// The three trained SPAM networks.
+    Spam,
+    /// The trained evaluator, rounded to f16.
+    Evaluator,
+    /// SPAM with random weights at the default sizes (configs/spam.json), for tests of the
+    /// plumbing before trained weights exist; never the default model.
+    Random,
+    /// The words and action labels of the training captions (from the dataset's
+    /// dataset.json), which the planner is told to use.
+    Vocabulary,
+}
+
+pub fn run(args: ExportArgs) -> Result<()> {
+    let ExportArgs {
+        what,
+        evaluator,
+        vq,
+        base,
+        res,
+        data,
+        out,
+    } = args;
+    match what {
+        ExportWhat::Random => {
+            use burn::config::Config;
+            let sizes = coma::model::SpamConfig::load("configs/spam.json")
+                .map_err(|e| anyhow::anyhow!("configs/spam.json: {e}"))?;
+            export::export_random(&sizes, &data, &out)?;
+            println!("wrote SPAM with random weights into {}", out.display());
+        }
+        ExportWhat::Vocabulary => {
+            let words = export::export_vocabulary(&data, &out)?;
+            println!(
+                "wrote {} words into {}",
+                words,
+                out.join("vocabulary.json").display()
+            );
+        }
+        ExportWhat::Evaluator => {
+            let exported = export::export_evaluator(&evaluator, &out)?;
+            println!(
+                "exported the evaluator into {} (f16, {} bytes)",
+                out.display(),
+                exported.bytes
+            );
+            match exported.rounding(&data) {
+                EvaluatorRounding::NoTestSplit => {
+                    println!("no test split in {}: f16 not compared", data.display())
+                }
+                EvaluatorRounding::NoSentenceEncoder => {
+                    println!("no sentence encoder in {}: f16 not compared", out.display())
+                }
+                EvaluatorRounding::Compared(a) => {
+                    let [full, rounded] = a.r_precision;
+                    println!(
+                        "f16 against the run's weights on {} random test motions and captions: alignment \
+                         scores (0-100) differ by at most {:.4} (mean {:.5}); R-precision top-1 {:.4} -> {:.4}, \
+                         top-3 {:.4} -> {:.4}; {} captions change their nearest motion",
+                        a.pairs,
+                        a.max_score_difference,
+                        a.mean_score_difference,
+                        full[0],
+                        rounded[0],
+                        full[2],
+                        rounded[2],
+                        a.changed_nearest
+                    );
+                }
+            }
+        }
+        ExportWhat::Spam => {
+            let exported = export::export_spam(&vq, &base, res.as_deref(), &data, &out)?;
+            println!(
+                "exported SPAM ({}) into {}: f16, {} bytes, model id {}",
+                if exported.has_residual() {
+                    "with its residual transformer"
+                } else {
+                    "base-only"
+                },
+                out.display(),
+                exported.bytes,
+                exported.id
+            );
+            let e = exported.vq_rounding(&data)?;
+            println!(
+                "VQ-VAE on {} test motions, {} of {} layers: {:.2} mm (f32) -> {:.2} mm (f16), root aligned",
+                e.motions, e.layers, e.vq_layers, e.f32_mm, e.f16_mm
+            );
+            let t = exported.token_rounding()?;
+            println!(
+                "greedily decoded tokens of 4 prompts (196 frames): {} of {} the same with f16 as with f32",
+                t.same, t.total
+            );
+        }
+    }
+    Ok(())
+}

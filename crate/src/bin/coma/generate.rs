@@ -1,0 +1,64 @@
+//! `coma generate`: a motion from a prompt.
+
+use crate::common::{load_model, write_outputs, ModelArgs};
+use anyhow::{bail, Result};
+use clap::Args;
+use coma::executor::block_on;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct GenerateArgs {
+    prompt: String,
+    /// Length in seconds (0.2 s steps, at most 9.8 s).
+    #[arg(long, default_value_t = 4.0)]
+    seconds: f64,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// A body part's own instruction, e.g. --part "left arm=waves the left hand".
+    #[arg(long = "part")]
+    parts: Vec<String>,
+    /// Motion file to write (.bvh, .npy features, .json joints).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Filmstrip PNG to write.
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Classifier-free guidance scale of the base transformer: 1 follows the learnt
+    /// conditional distribution, more follows the text harder (default 4).
+    #[arg(long)]
+    guidance: Option<f32>,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+pub fn run(args: GenerateArgs) -> Result<()> {
+    let parts = parse_parts(&args.parts)?;
+    let model = load_model(&args.model.models)?;
+    let frames = coma::timing::frames_for_seconds(args.seconds);
+    let mut options = coma::model::motion_model::sampling(args.seed);
+    match args.guidance {
+        Some(g) if g.is_finite() && g >= 0.0 => options.base_guidance = g,
+        Some(g) => bail!("--guidance must be a number of 0 or more, not {g}"),
+        None => {}
+    }
+    let tokens = block_on(model.generate_with(&args.prompt, &parts, frames, &options));
+    write_outputs(
+        &block_on(model.features(&tokens)),
+        args.out.as_deref(),
+        args.png.as_deref(),
+        &args.prompt,
+    )
+}
+
+/// `--part "left arm=…"` arguments as (part, instruction).
+fn parse_parts(parts: &[String]) -> Result<Vec<(coma::skeleton::BodyPart, String)>> {
+    parts
+        .iter()
+        .map(|p| {
+            let (name, instruction) = p.split_once('=').ok_or_else(|| anyhow::anyhow!("--part '{p}': expected 'left arm=instruction'"))?;
+            let part = coma::skeleton::BodyPart::parse(name)
+                .ok_or_else(|| anyhow::anyhow!("--part '{p}': unknown body part '{name}' (left arm, right arm, left leg, right leg)"))?;
+            Ok((part, instruction.trim().to_string()))
+        })
+        .collect()
+}

@@ -1,0 +1,118 @@
+//! `coma plan`: the plan of a prompt (segments, base motions, part edits, paths), or the
+//! planner scored on a prompt set.
+
+use crate::common::{llm_of, LlmArgs};
+use anyhow::Result;
+use clap::Args;
+use coma::agents::planner;
+use coma::executor::block_on;
+use coma::plan::Plan;
+use coma::session::{self, PlanningContext, Progress, VOCABULARY_FILE};
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct PlanArgs {
+    /// The prompt.
+    #[arg(required_unless_present = "prompts")]
+    prompt: Option<String>,
+    #[command(flatten)]
+    llm: LlmArgs,
+    /// Print the plan as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Instead of one prompt, plan every prompt of a prompt set (eval/prompts.json) and
+    /// report how often the segment count matches the prompt's temporal structure.
+    #[arg(long, conflicts_with = "prompt")]
+    prompts: Option<PathBuf>,
+    /// Stretch or shrink the plan to about this many seconds (as the page's Seconds field).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Folder with vocabulary.json and the sentence encoder.
+    #[arg(long, default_value = "static/models")]
+    models: PathBuf,
+}
+
+pub fn print_plan(plan: &Plan) {
+    println!("rewritten: {}", plan.rewritten);
+    for (i, s) in plan.segments.iter().enumerate() {
+        println!("{}. {:.1} s  {}", i + 1, s.seconds, s.text);
+        println!("   base: {}", s.base);
+        for (part, text) in s.parts.edits() {
+            println!("   {}: {text}", part.name());
+        }
+        if let Some(t) = &s.trajectory {
+            println!("   path: {}", t.describe());
+        }
+    }
+    for n in &plan.notes {
+        println!("note: {n}");
+    }
+}
+
+/// One progress line to stderr, when `verbose`.
+pub fn print_progress(progress: &Progress, verbose: bool) {
+    if let (Progress::Step { line, .. }, true) = (progress, verbose) {
+        eprintln!("{line}");
+    }
+}
+
+pub fn run(args: PlanArgs) -> Result<()> {
+    let client = args.llm.client()?;
+    let llm = llm_of(&client);
+    // The engine plans without SPAM: the vocabulary and the sentence encoder are enough, and
+    // the engine decides what to do without them.
+    let vocabulary = session::read_vocabulary(&args.models.join(VOCABULARY_FILE));
+    if let Err(e) = &vocabulary {
+        eprintln!("note: {e}");
+    }
+    let encoder =
+        coma::text::minilm::SentenceEncoder::from_dir(&args.models, &burn::tensor::Device::flex())
+            .ok();
+    let embed_fn = |s: &str| {
+        encoder
+            .as_ref()
+            .map(|e| e.encode(&[s])[0].to_vec())
+            .unwrap_or_default()
+    };
+    let context = PlanningContext {
+        vocabulary: vocabulary.as_ref().ok(),
+        embed: encoder
+            .as_ref()
+            .map(|_| &embed_fn as planner::offline::Embedder),
+    };
+    let plan_one = |prompt: &str, verbose: bool| -> Result<Plan> {
+        Ok(block_on(session::plan_prompt(
+            prompt,
+            args.seconds,
+            &llm,
+            &context,
+            &mut |p| print_progress(&p, verbose),
+        ))?)
+    };
+    if let Some(set) = &args.prompts {
+        let mut failed = None;
+        let report = planner::prompt_set::score(set, |p| {
+            plan_one(p, false).unwrap_or_else(|e| {
+                failed = Some(format!("'{p}': {e}"));
+                planner::offline::plan(p, None)
+            })
+        })?;
+        if let Some(e) = failed {
+            anyhow::bail!("a prompt of the set did not plan: {e}");
+        }
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            print!("{}", report.table());
+        }
+        return Ok(());
+    }
+    let prompt = args.prompt.expect("clap requires a prompt");
+    let plan = plan_one(&prompt, !args.json)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&plan)?);
+    } else {
+        print_plan(&plan);
+    }
+    Ok(())
+}

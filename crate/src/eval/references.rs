@@ -1,0 +1,67 @@
+//! The dataset's real motions that the control probes hold generated motions against: the
+//! training performances of an action (`coma probe bow|wave`), and the test motions whose
+//! frame-to-frame speeds bound how fast a blend's join may be (`coma probe continuity`,
+//! `coma eval`).
+
+use super::probes::{continuity, quantile, real_performances, ActionProbe, ContinuityReport};
+use crate::dataset::motions::MotionSet;
+use crate::dataset::Split;
+use crate::model::MotionModel;
+use crate::skeleton::Pose;
+use anyhow::Result;
+use std::path::Path;
+
+/// How much of an action the dataset's own performances show, by the probe's measure (in
+/// its unit): the bar generated motions of the action's prompt are held to.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ActionReference {
+    /// Training motions labelled with the action.
+    pub motions: usize,
+    /// Median of their measures.
+    pub median: f64,
+    /// 10th percentile of their measures: a generated motion that reaches it performs the
+    /// action about as much as the dataset does.
+    pub p10: f64,
+}
+
+/// The probe's measure over the training motions of `data` that show its action; an error
+/// when none is labelled with it.
+pub fn action_reference(data: &Path, probe: &ActionProbe) -> Result<ActionReference> {
+    let set = MotionSet::load(data, Split::Train)?;
+    let real = real_performances(&set, probe);
+    anyhow::ensure!(
+        !real.is_empty(),
+        "no training motion of {} is labelled {:?}",
+        data.display(),
+        probe.content
+    );
+    Ok(ActionReference {
+        motions: real.len(),
+        p10: quantile(real.clone(), 0.1),
+        median: quantile(real, 0.5),
+    })
+}
+
+/// Every motion of `set` as joint positions (metres, Y up, 20 fps): the real motion whose
+/// speeds [`continuity`] compares a join with.
+pub fn reference_motions(set: &MotionSet) -> Vec<Vec<Pose>> {
+    set.items.iter().map(|i| set.joints(i)).collect()
+}
+
+/// The first segment of the continuity probe: a walk...
+pub const CONTINUITY_FIRST: &str = "a person walks forward";
+/// ...blended into a bow, a change of pace and posture that a bad join shows as a jump.
+pub const CONTINUITY_SECOND: &str = "a person bows";
+
+/// The continuity probe as `coma probe continuity` and `coma eval` run it: a walk blended
+/// into a bow (seed `seed`), its join's speeds against the 99th percentile of the motions of
+/// `reference` (the test split).
+pub fn walk_to_bow(model: &MotionModel, reference: &MotionSet, seed: u64) -> ContinuityReport {
+    continuity(
+        model,
+        CONTINUITY_FIRST,
+        CONTINUITY_SECOND,
+        &reference_motions(reference),
+        seed,
+    )
+}

@@ -1,0 +1,356 @@
+//! Assembling trained runs into a model folder (`coma export`): SPAM's three networks and the
+//! evaluator rounded to f16 (the page's weights), and what that rounding changes in the
+//! motions they reconstruct, the tokens they generate and the scores they give; SPAM with
+//! random weights for tests of the plumbing; the training captions' vocabulary for the planner.
+
+use crate::dataset::motions::MotionSet;
+use crate::dataset::Split;
+use crate::eval::agreement::{agreement, Agreement};
+use crate::executor::block_on;
+use crate::features::FeatureFrame;
+use crate::model::evaluator::{Evaluator, EvaluatorConfig};
+use crate::model::generate::SamplingOptions;
+use crate::model::transformer::PARTS;
+use crate::model::{Spam, SpamConfig, SpamFiles, RESIDUAL_FILE};
+use crate::text::minilm::SentenceEncoder;
+use crate::train::evaluator::EvaluatorTrainingConfig;
+use crate::train::transformer::TransformerTrainingConfig;
+use crate::train::vq::{reconstruction_errors, VqTrainingConfig};
+use anyhow::{Context, Result};
+use burn::config::Config;
+use burn::module::Module;
+use burn::tensor::Device;
+use std::path::{Path, PathBuf};
+
+/// Prompts whose greedily decoded tokens [`ExportedSpam::token_rounding`] compares between the f32
+/// and f16 weights: a walk, a wave and a raise of one hand each, and a bow.
+pub const ROUNDING_PROMPTS: [&str; 4] = [
+    "a person walks forward",
+    "a person waves the left hand",
+    "a person raises the right hand",
+    "a person bows",
+];
+
+/// Frames of motion (9.8 s at 20 fps) generated per prompt of [`ROUNDING_PROMPTS`].
+pub const ROUNDING_FRAMES: usize = 196;
+
+/// Test motions whose reconstruction error [`ExportedSpam::vq_rounding`] measures.
+pub const ROUNDING_VQ_MOTIONS: usize = 200;
+
+/// Captioned test motions on which [`ExportedEvaluator::rounding`] compares the scores.
+pub const ROUNDING_EVALUATOR_MOTIONS: usize = 224;
+
+/// SPAM written to a model folder in f16, beside the f32 weights of its runs.
+#[derive(Debug)]
+pub struct ExportedSpam {
+    /// The model folder written.
+    pub dir: PathBuf,
+    /// The networks' sizes, as written to `spam.json`.
+    pub sizes: SpamConfig,
+    /// The runs' weights as trained (f32).
+    pub full: Spam,
+    /// The weights as the folder holds them (rounded to f16), loaded back from it.
+    pub half: Spam,
+    /// Bytes of the folder's weight files (see [`SpamConfig::weight_files`]).
+    pub bytes: u64,
+    /// The folder's model id (see [`crate::model::model_id`]), which share links name.
+    pub id: String,
+}
+
+/// What rounding SPAM to f16 changes in the motions its VQ-VAE reconstructs.
+#[derive(Clone, Debug)]
+pub struct VqRounding {
+    /// Test motions reconstructed.
+    pub motions: usize,
+    /// Token layers decoded (those generation produces) and the VQ-VAE's layers.
+    pub layers: usize,
+    pub vq_layers: usize,
+    /// Mean per-joint position error of the reconstructions, root aligned, in millimetres,
+    /// with the f32 and with the f16 weights.
+    pub f32_mm: f64,
+    pub f16_mm: f64,
+}
+
+/// What rounding SPAM to f16 changes in the tokens it generates: of the tokens of
+/// [`ROUNDING_PROMPTS`], greedily decoded, how many are the same with both weights.
+#[derive(Clone, Copy, Debug)]
+pub struct TokenRounding {
+    pub same: usize,
+    pub total: usize,
+}
+
+/// `coma export spam`: the runs' final weights (`vq.bpk`, `base.bpk`, and `residual.bpk`
+/// when `res` names the residual transformer's run; without it the model is base-only)
+/// rounded to f16 into `out` with `spam.json` and the feature statistics of `data`
+/// (`Mean.npy`, `Std.npy`), then loaded back. [`ExportedSpam::vq_rounding`] and
+/// [`ExportedSpam::token_rounding`] say what the rounding changes.
+pub fn export_spam(
+    vq: &Path,
+    base: &Path,
+    res: Option<&Path>,
+    data: &Path,
+    out: &Path,
+) -> Result<ExportedSpam> {
+    let read = |p: PathBuf| std::fs::read(&p).with_context(|| p.display().to_string());
+    let transformer = |run: &Path| {
+        TransformerTrainingConfig::load(run.join("config.json"))
+            .map(|c| c.model)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", run.join("config.json").display()))
+    };
+    let sizes = SpamConfig::new(
+        VqTrainingConfig::load(vq.join("config.json"))
+            .map_err(|e| anyhow::anyhow!("{}: {e}", vq.join("config.json").display()))?
+            .model,
+        transformer(base)?,
+    )
+    .with_residual(res.map(transformer).transpose()?);
+    let config = serde_json::to_string_pretty(&sizes)?;
+    let (vq_bytes, base_bytes) = (read(vq.join("vq.bpk"))?, read(base.join("base.bpk"))?);
+    let res_bytes = res.map(|r| read(r.join("residual.bpk"))).transpose()?;
+    let (mean, std) = (read(data.join("Mean.npy"))?, read(data.join("Std.npy"))?);
+    let device = Device::flex();
+    let files = SpamFiles {
+        config: &config,
+        vq: &vq_bytes,
+        base: &base_bytes,
+        residual: res_bytes.as_deref(),
+        mean: &mean,
+        std: &std,
+    };
+    let (full, _) = Spam::from_bytes(&files, &device)?;
+
+    std::fs::create_dir_all(out)?;
+    let write = |name: &str, bytes: &[u8]| {
+        std::fs::write(out.join(name), bytes).with_context(|| out.join(name).display().to_string())
+    };
+    write("spam.json", config.as_bytes())?;
+    write("vq.bpk", &crate::weights::f16_bytes(&full.vq)?)?;
+    write("base.bpk", &crate::weights::f16_bytes(&full.base)?)?;
+    match &full.residual {
+        Some(r) => write(RESIDUAL_FILE, &crate::weights::f16_bytes(&r.network)?)?,
+        // A stale residual file would make the folder fail to load.
+        None => match std::fs::remove_file(out.join(RESIDUAL_FILE)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e)?,
+            _ => {}
+        },
+    }
+    write("mean.npy", &mean)?;
+    write("std.npy", &std)?;
+    let (half, _, id) = Spam::load(out, &device)?;
+    let bytes: u64 = sizes
+        .weight_files()
+        .iter()
+        .map(|f| std::fs::metadata(out.join(f)).map_or(0, |m| m.len()))
+        .sum();
+    Ok(ExportedSpam {
+        dir: out.to_path_buf(),
+        sizes,
+        full,
+        half,
+        bytes,
+        id,
+    })
+}
+
+impl ExportedSpam {
+    /// True when the motions generated from the exported folder get their finer token layers
+    /// from a residual transformer; false for a base-only model.
+    pub fn has_residual(&self) -> bool {
+        self.half.residual.is_some()
+    }
+
+    /// What the rounding changes in reconstructions: the VQ-VAE's error on
+    /// [`ROUNDING_VQ_MOTIONS`] test motions of `data`, decoding the layers generation
+    /// produces.
+    pub fn vq_rounding(&self, data: &Path) -> Result<VqRounding> {
+        let device = Device::flex();
+        let test = MotionSet::load(data, Split::Test)?;
+        let layers = self.half.generated_layers();
+        let error = |spam: &Spam| {
+            reconstruction_errors(&spam.vq, &test, &device, ROUNDING_VQ_MOTIONS, layers)
+        };
+        let (e32, e16) = (error(&self.full)?, error(&self.half)?);
+        Ok(VqRounding {
+            motions: e32.motions,
+            layers,
+            vq_layers: self.sizes.vq.layers,
+            f32_mm: e32.root_aligned_mm,
+            f16_mm: e16.root_aligned_mm,
+        })
+    }
+
+    /// What the rounding changes in generation: the tokens greedy decoding picks for
+    /// [`ROUNDING_PROMPTS`] ([`ROUNDING_FRAMES`] frames each, texts embedded by the sentence
+    /// encoder in the folder).
+    pub fn token_rounding(&self) -> Result<TokenRounding> {
+        let device = Device::flex();
+        let text = SentenceEncoder::from_dir(&self.dir, &device)?;
+        let (mut same, mut total) = (0usize, 0usize);
+        for (i, prompt) in ROUNDING_PROMPTS.iter().enumerate() {
+            let condition = [text.encode(&[prompt])[0]; PARTS];
+            // Greedy: sampling would turn the smallest change of a probability into another
+            // code, and every later step would follow it.
+            let options = SamplingOptions {
+                seed: i as u64,
+                temperature: 0.0,
+                ..Default::default()
+            };
+            let [a, b] = [&self.full, &self.half]
+                .map(|spam| block_on(spam.generate(&condition, ROUNDING_FRAMES, &options)));
+            for (x, y) in a
+                .iter()
+                .flatten()
+                .flatten()
+                .zip(b.iter().flatten().flatten())
+            {
+                same += (x == y) as usize;
+                total += 1;
+            }
+        }
+        Ok(TokenRounding { same, total })
+    }
+}
+
+/// The text–motion evaluator written to a model folder in f16, beside its run's f32 weights.
+pub struct ExportedEvaluator {
+    /// The model folder written.
+    pub dir: PathBuf,
+    /// The run's weights as trained (f32).
+    pub original: Evaluator,
+    /// The weights as the folder holds them (rounded to f16), loaded back from it.
+    pub half: Evaluator,
+    pub config: EvaluatorConfig,
+    /// Size of the folder's `evaluator.bpk`.
+    pub bytes: usize,
+}
+
+/// What rounding the evaluator to f16 changes, when it could be measured.
+#[derive(Clone, Debug)]
+pub enum EvaluatorRounding {
+    /// The dataset has no test split to measure on.
+    NoTestSplit,
+    /// The model folder has no sentence encoder to embed the captions.
+    NoSentenceEncoder,
+    /// The f32 and f16 evaluators' scores and retrieval on the same captioned test motions.
+    Compared(Agreement),
+}
+
+/// `coma export evaluator`: the run's weights (`evaluator.bpk`, sizes from its
+/// `config.json`) rounded to f16 into `out` as `evaluator.bpk` and `evaluator.json`, then
+/// loaded back. [`ExportedEvaluator::rounding`] says what the rounding changes.
+pub fn export_evaluator(run: &Path, out: &Path) -> Result<ExportedEvaluator> {
+    let device = Device::flex();
+    let cfg = EvaluatorTrainingConfig::load(run.join("config.json"))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", run.join("config.json").display()))?;
+    let original = Evaluator::load_weights(&cfg.model, &run.join("evaluator.bpk"), &device)?;
+    std::fs::create_dir_all(out)?;
+    cfg.model
+        .save(out.join("evaluator.json"))
+        .map_err(|e| anyhow::anyhow!("writing evaluator.json: {e}"))?;
+    let weights = out.join("evaluator.bpk");
+    let bytes = original.to_f16_bytes()?;
+    std::fs::write(&weights, &bytes).with_context(|| weights.display().to_string())?;
+    let (half, config) = Evaluator::load(out, &device)?;
+    Ok(ExportedEvaluator {
+        dir: out.to_path_buf(),
+        original,
+        half,
+        config,
+        bytes: bytes.len(),
+    })
+}
+
+impl ExportedEvaluator {
+    /// What the rounding changes on [`ROUNDING_EVALUATOR_MOTIONS`] random captioned test
+    /// motions of `data`, each with a random one of its captions (when `data` has a test
+    /// split and the folder a sentence encoder).
+    pub fn rounding(&self, data: &Path) -> EvaluatorRounding {
+        let device = Device::flex();
+        let Ok(test) = MotionSet::load(data, Split::Test) else {
+            return EvaluatorRounding::NoTestSplit;
+        };
+        let Ok(text) = SentenceEncoder::from_dir(&self.dir, &device) else {
+            return EvaluatorRounding::NoSentenceEncoder;
+        };
+        // As one repetition of `coma eval`: motions in a random order (neighbouring test
+        // motions are windows of the same take, which would crowd a batch of 32) with a
+        // random caption.
+        let mut rng = crate::rng::Rng::new(0);
+        let mut items: Vec<_> = test
+            .items
+            .iter()
+            .filter(|i| !i.captions.is_empty())
+            .collect();
+        rng.shuffle(&mut items);
+        items.truncate(ROUNDING_EVALUATOR_MOTIONS);
+        let motions: Vec<&[FeatureFrame]> = items.iter().map(|i| i.features.as_slice()).collect();
+        let captions: Vec<&str> = items
+            .iter()
+            .map(|i| i.captions[rng.below(i.captions.len())].as_str())
+            .collect();
+        let sentences: Vec<_> = captions.chunks(64).flat_map(|c| text.encode(c)).collect();
+        EvaluatorRounding::Compared(agreement(
+            &self.original,
+            &self.half,
+            &self.config,
+            &motions,
+            &sentences,
+            &device,
+        ))
+    }
+}
+
+/// `coma export random`: SPAM with random weights at `sizes` and the feature statistics of
+/// `data` into `out`, loaded back to check the folder: a model that moves, but not as any
+/// prompt asks, for tests of the plumbing before trained weights exist.
+pub fn export_random(sizes: &SpamConfig, data: &Path, out: &Path) -> Result<()> {
+    let device = Device::flex();
+    let spam = Spam::random(&sizes.vq, &sizes.base, sizes.residual.as_ref(), &device);
+    std::fs::create_dir_all(out)?;
+    sizes
+        .save(out.join("spam.json"))
+        .map_err(|e| anyhow::anyhow!("writing spam.json: {e}"))?;
+    let save =
+        |r: Result<(), _>, name: &str| r.map_err(|e| anyhow::anyhow!("writing {name}: {e:?}"));
+    save(spam.vq.clone().save_file(out.join("vq.bpk")), "vq.bpk")?;
+    save(
+        spam.base.clone().save_file(out.join("base.bpk")),
+        "base.bpk",
+    )?;
+    if let Some(residual) = &spam.residual {
+        save(
+            residual.network.clone().save_file(out.join("residual.bpk")),
+            "residual.bpk",
+        )?;
+    }
+    for (from, to) in [("Mean.npy", "mean.npy"), ("Std.npy", "std.npy")] {
+        std::fs::copy(data.join(from), out.join(to))
+            .with_context(|| format!("copying {}", data.join(from).display()))?;
+    }
+    Spam::load(out, &device)?;
+    Ok(())
+}
+
+/// `coma export vocabulary`: the words and action labels of the training captions (the
+/// `vocabulary` of `data`'s `dataset.json`, with its licence), which the planner is told to
+/// describe motions with, written to `out/vocabulary.json`. Returns the number of words.
+pub fn export_vocabulary(data: &Path, out: &Path) -> Result<usize> {
+    let path = data.join("dataset.json");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?,
+    )?;
+    let mut vocabulary = summary["vocabulary"].clone();
+    anyhow::ensure!(
+        vocabulary["words"].is_array(),
+        "{} has no vocabulary (rebuild it with `coma data build`)",
+        path.display()
+    );
+    vocabulary["licence"] = summary["licence"].clone();
+    std::fs::create_dir_all(out)?;
+    std::fs::write(
+        out.join("vocabulary.json"),
+        serde_json::to_string_pretty(&vocabulary)? + "\n",
+    )?;
+    Ok(vocabulary["words"].as_array().map_or(0, Vec::len))
+}

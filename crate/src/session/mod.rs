@@ -1,0 +1,325 @@
+//! The engine: one place that runs the product's pipeline for the page's worker, the command
+//! line and the evaluation. A [`Session`] holds the loaded models (SPAM with its sentence
+//! encoder, the evaluator, the training vocabulary); it takes a typed [`Command`], reports
+//! [`Progress`] while it works, and answers with a typed [`Outcome`]. It decides every
+//! fallback once (no vocabulary, no LLM, an LLM that fails: see [`planning`]) and fits the
+//! plan to the length asked for, so the page and the command line agree.
+//!
+//! ```text
+//!  page ─ Request ─► worker ─ Command ─► Session ─► planner ─► pipeline (SPAM, reviewer) ─┐
+//!  CLI  ─ args ────────────── Command ─►   │                                               │
+//!  eval ───────────────────── Command ─►   └──────────── Outcome (plan, tokens, motion) ◄──┘
+//! ```
+//!
+//! Everything is async because the model's reads from a browser's WebGPU device are; natively
+//! the futures complete at once and [`crate::executor::block_on`] drives them.
+
+pub mod command;
+pub mod planning;
+pub mod progress;
+
+pub use command::{Command, Llm, Motion, Outcome, Progress, RunOutcome, SessionError};
+pub use planning::{plan_prompt, PlanningContext};
+
+use crate::agents::llm::Transport;
+use crate::agents::pipeline::{self, RunOptions};
+use crate::agents::reviewer::Scorer;
+use crate::dataset::Vocabulary;
+use crate::features::features_to_joints;
+use crate::model::evaluator::{Evaluator, EvaluatorConfig};
+use crate::model::tokens::MotionTokens;
+use crate::model::MotionModel;
+use crate::plan::Plan;
+use crate::skeleton::BodyPart;
+use crate::timing::{frames_for_seconds, seconds};
+use progress::{run_event_line, run_steps, Steps};
+
+/// The vocabulary's file name beside the weights.
+pub const VOCABULARY_FILE: &str = "vocabulary.json";
+
+/// The loaded models and what they answer.
+pub struct Session {
+    model: MotionModel,
+    evaluator: Option<(Evaluator, EvaluatorConfig)>,
+    vocabulary: Option<Vocabulary>,
+}
+
+impl Session {
+    /// A session of `model` with the evaluator and the vocabulary where they loaded. Returns
+    /// the session and, for what did not load, a line saying what works without it (no
+    /// evaluator: motions are not reviewed; no vocabulary: the built-in planner plans even
+    /// with an LLM set).
+    pub fn new(
+        model: MotionModel,
+        evaluator: Result<(Evaluator, EvaluatorConfig), String>,
+        vocabulary: Result<Vocabulary, String>,
+    ) -> (Session, Vec<String>) {
+        let mut missing = Vec::new();
+        let evaluator = evaluator
+            .map_err(|e| missing.push(format!("the evaluator ({e}): motions are not reviewed")))
+            .ok();
+        let vocabulary = vocabulary
+            .map_err(|e| {
+                missing.push(format!(
+                    "the model's vocabulary ({e}): the built-in planner plans even with an LLM set"
+                ))
+            })
+            .ok();
+        let session = Session {
+            model,
+            evaluator,
+            vocabulary,
+        };
+        (session, missing)
+    }
+
+    /// The session of the model in a folder (the default one is `static/models`): SPAM and
+    /// the sentence encoder must load; the evaluator and the vocabulary may be missing.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn load(
+        dir: &std::path::Path,
+        device: &burn::tensor::Device,
+    ) -> Result<(Session, Vec<String>), SessionError> {
+        let model = MotionModel::load(dir, device).map_err(|e| {
+            SessionError(format!("the model in {} does not load: {e}", dir.display()))
+        })?;
+        let evaluator =
+            Evaluator::load(dir, &burn::tensor::Device::flex()).map_err(|e| e.to_string());
+        let vocabulary = read_vocabulary(&dir.join(VOCABULARY_FILE));
+        Ok(Session::new(model, evaluator, vocabulary))
+    }
+
+    /// The motion model.
+    pub fn model(&self) -> &MotionModel {
+        &self.model
+    }
+
+    /// The training vocabulary, where it loaded.
+    pub fn vocabulary(&self) -> Option<&Vocabulary> {
+        self.vocabulary.as_ref()
+    }
+
+    /// The evaluator as the reviewer's judge, where it loaded.
+    pub fn scorer(&self) -> Option<Scorer<'_>> {
+        self.evaluator.as_ref().map(|(evaluator, config)| Scorer {
+            evaluator,
+            config,
+            model: &self.model,
+        })
+    }
+
+    /// MiniLM's embedding of one sentence.
+    fn embed(&self, text: &str) -> Vec<f32> {
+        self.model.text.encode(&[text])[0].to_vec()
+    }
+
+    /// Carries out `command`, reporting progress; `llm` plans and judges where it is on.
+    pub async fn execute<T: Transport>(
+        &self,
+        command: Command,
+        llm: &Llm<'_, T>,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Outcome, SessionError> {
+        match command {
+            Command::Plan { prompt, seconds } => {
+                let embed = |s: &str| self.embed(s);
+                let context = PlanningContext {
+                    vocabulary: self.vocabulary.as_ref(),
+                    embed: Some(&embed),
+                };
+                let plan = plan_prompt(&prompt, seconds, llm, &context, progress).await?;
+                Ok(Outcome::Plan { plan })
+            }
+            Command::Run {
+                prompt,
+                seed,
+                rounds,
+                seconds,
+                plan,
+            } => {
+                let run = self
+                    .run(
+                        &prompt,
+                        plan,
+                        seconds,
+                        RunOptions { rounds, seed },
+                        llm,
+                        progress,
+                    )
+                    .await?;
+                Ok(Outcome::Run(Box::new(run)))
+            }
+            Command::Generate {
+                prompt,
+                seconds,
+                seed,
+                parts,
+            } => {
+                if prompt.trim().is_empty() {
+                    return Err("type what the person should do first".into());
+                }
+                let tokens = self
+                    .model
+                    .generate(&prompt, &parts, frames_for_seconds(seconds), seed)
+                    .await;
+                self.motion_outcome(tokens, None).await
+            }
+            Command::InBetween {
+                tokens,
+                text,
+                from,
+                to,
+                seed,
+                plan,
+            } => {
+                self.fits(&tokens)?;
+                let frames = tokens.frames();
+                if from >= to || from >= frames {
+                    return Err(format!(
+                        "choose a time range inside the motion (0 to {:.1} s)",
+                        seconds(frames)
+                    )
+                    .into());
+                }
+                let tokens = self
+                    .model
+                    .inbetween(&tokens, &text, from, to.min(frames), seed)
+                    .await;
+                self.motion_outcome(tokens, plan.as_ref()).await
+            }
+            Command::EditParts {
+                tokens,
+                text,
+                parts,
+                seed,
+                plan,
+            } => {
+                self.fits(&tokens)?;
+                if parts.is_empty() {
+                    return Err("choose at least one body part to edit".into());
+                }
+                let tokens = self.edit_parts(&tokens, &text, &parts, seed).await;
+                self.motion_outcome(tokens, plan.as_ref()).await
+            }
+            Command::Decode { tokens, plan } => {
+                self.fits(&tokens)?;
+                self.motion_outcome(tokens, plan.as_ref()).await
+            }
+        }
+    }
+
+    /// Plans (unless a plan is given), then runs the loop and decodes the motion.
+    async fn run<T: Transport>(
+        &self,
+        prompt: &str,
+        given: Option<Plan>,
+        seconds: Option<f64>,
+        options: RunOptions,
+        llm: &Llm<'_, T>,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<RunOutcome, SessionError> {
+        let mut steps = Steps::new(progress);
+        let plan = match given {
+            Some(mut plan) => {
+                if let Some(seconds) = seconds {
+                    plan.fit_seconds(seconds);
+                }
+                for event in progress::plan_events(&plan) {
+                    steps.step(progress::plan_event_line(&event));
+                }
+                plan
+            }
+            None => {
+                let embed = |s: &str| self.embed(s);
+                let context = PlanningContext {
+                    vocabulary: self.vocabulary.as_ref(),
+                    embed: Some(&embed),
+                };
+                planning::plan_with(prompt, seconds, llm, &context, &mut steps).await?
+            }
+        };
+        steps.report(Progress::Planned { plan: plan.clone() });
+        steps.expect(run_steps(&plan, options.rounds));
+        let scorer = self.scorer();
+        let run = pipeline::run(
+            &self.model,
+            scorer.as_ref(),
+            llm.client(),
+            plan,
+            options,
+            &mut |event| steps.step(run_event_line(&event)),
+        )
+        .await;
+        let (motion, path_notes) = self.motion(run.tokens, Some(&run.plan)).await;
+        let paths = pipeline::path_reports(&run.plan, &motion.tokens, &motion.features);
+        let notes = run.plan.notes.iter().chain(&run.notes).cloned().collect();
+        Ok(RunOutcome {
+            motion,
+            plan: run.plan,
+            history: run.history,
+            segments: run.segments,
+            paths,
+            notes,
+            path_notes,
+        })
+    }
+
+    /// The chosen parts regenerated from `text`, the rest conditioned on a description of
+    /// what the whole motion does now.
+    async fn edit_parts(
+        &self,
+        tokens: &MotionTokens,
+        text: &str,
+        parts: &[BodyPart],
+        seed: u64,
+    ) -> MotionTokens {
+        let rest = crate::posecodes::describe_motion(&self.model.joints(tokens).await);
+        self.model
+            .edit_parts(tokens, text, parts, &rest, seed)
+            .await
+    }
+
+    /// Tokens from outside must fit the loaded model.
+    fn fits(&self, tokens: &MotionTokens) -> Result<(), SessionError> {
+        let vq = &self.model.spam.vq_config;
+        tokens
+            .fits(vq.layers, vq.codebook_size)
+            .map_err(|e| SessionError(e.to_string()))
+    }
+
+    async fn motion_outcome(
+        &self,
+        tokens: MotionTokens,
+        plan: Option<&Plan>,
+    ) -> Result<Outcome, SessionError> {
+        let (motion, notes) = self.motion(tokens, plan).await;
+        Ok(Outcome::Motion { motion, notes })
+    }
+
+    /// The motion of `tokens` with the paths of `plan` laid on its root; the notes say which
+    /// paths could not be laid.
+    async fn motion(&self, tokens: MotionTokens, plan: Option<&Plan>) -> (Motion, Vec<String>) {
+        let (features, notes) = match plan {
+            Some(plan) => pipeline::motion_features(&self.model, plan, &tokens).await,
+            None => (self.model.features(&tokens).await, Vec::new()),
+        };
+        let joints = features_to_joints(&features)
+            .iter()
+            .map(|p| p.map(|j| j.map(|v| v as f32)))
+            .collect();
+        let motion = Motion {
+            tokens,
+            joints,
+            features,
+        };
+        (motion, notes)
+    }
+}
+
+/// The training vocabulary from its file.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn read_vocabulary(path: &std::path::Path) -> Result<Vocabulary, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{} does not read: {e}", path.display()))
+}

@@ -1,0 +1,78 @@
+//! The one place that decides who plans a prompt: the LLM planner when an LLM is configured
+//! and the model's vocabulary loaded, else the built-in planner, with a note saying why
+//! whenever a configured LLM was not used; then the user's length, if any, is fitted.
+
+use super::command::{Llm, Progress, SessionError};
+use super::progress::{plan_event_line, plan_events, Steps};
+use crate::agents::llm::Transport;
+use crate::agents::planner::{self, offline::Embedder};
+use crate::dataset::Vocabulary;
+use crate::plan::Plan;
+
+/// What planning reads besides the prompt.
+pub struct PlanningContext<'a> {
+    /// The model's training vocabulary (`vocabulary.json`); the LLM planner needs it.
+    pub vocabulary: Option<&'a Vocabulary>,
+    /// MiniLM sentence embeddings, so the built-in planner can map unknown movements onto
+    /// the training actions.
+    pub embed: Option<Embedder<'a>>,
+}
+
+/// Plans `prompt` and fits it to `seconds` when given, reporting every planner step.
+pub async fn plan_prompt<T: Transport>(
+    prompt: &str,
+    seconds: Option<f64>,
+    llm: &Llm<'_, T>,
+    context: &PlanningContext<'_>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Plan, SessionError> {
+    let mut steps = Steps::new(progress);
+    let plan = plan_with(prompt, seconds, llm, context, &mut steps).await?;
+    steps.report(Progress::Planned { plan: plan.clone() });
+    Ok(plan)
+}
+
+pub(super) async fn plan_with<T: Transport>(
+    prompt: &str,
+    seconds: Option<f64>,
+    llm: &Llm<'_, T>,
+    context: &PlanningContext<'_>,
+    steps: &mut Steps<'_>,
+) -> Result<Plan, SessionError> {
+    if prompt.trim().is_empty() {
+        return Err("type what the person should do first".into());
+    }
+    let mut fallback_note = None;
+    let mut plan = match (llm, context.vocabulary) {
+        (Llm::On(client), Some(vocabulary)) => {
+            steps.step(format!("planning with {}…", client.config().model));
+            planner::llm::plan(client, prompt, vocabulary, context.embed, &mut |event| {
+                steps.step(plan_event_line(event))
+            })
+            .await
+        }
+        (llm, _) => {
+            fallback_note = match llm {
+                Llm::On(_) => Some(
+                    "the model's vocabulary did not load, so the built-in planner planned".into(),
+                ),
+                Llm::Unusable(why) => Some(format!(
+                    "the LLM is not used ({why}); the built-in planner planned"
+                )),
+                Llm::Off => None,
+            };
+            planner::offline::plan(prompt, context.embed)
+        }
+    };
+    plan.notes.splice(0..0, fallback_note);
+    if let Some(seconds) = seconds {
+        plan.fit_seconds(seconds);
+    }
+    if steps.done() == 0 {
+        // Planned in one go: its steps, as fitted.
+        for event in plan_events(&plan) {
+            steps.step(plan_event_line(&event));
+        }
+    }
+    Ok(plan)
+}

@@ -1,0 +1,69 @@
+//! Share links made before the engine refactor (issue 16) still open to the same motion: a
+//! version-2 link of a planned run and a version-1 link with an older segments-only plan,
+//! recorded with `crate/examples/record_links.rs` at that time, with the joints each opened
+//! to then (`fixtures/links/*.joints.csv`, 6 decimals).
+
+use coma::executor::block_on;
+use coma::session::{Command, Llm, Outcome, Session};
+use coma::share::{self, LinkPlan};
+use std::path::{Path, PathBuf};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .into()
+}
+
+fn recorded_joints(name: &str) -> Vec<Vec<f32>> {
+    let path = repo().join(format!("crate/tests/fixtures/links/{name}.joints.csv"));
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+#[test]
+fn links_of_both_versions_open_to_the_motion_they_were_made_with() {
+    let (session, _) =
+        Session::load(&repo().join("static/models"), &burn::tensor::Device::flex()).unwrap();
+    for name in ["v1", "v2"] {
+        let text =
+            std::fs::read_to_string(repo().join(format!("crate/tests/fixtures/links/{name}.link")))
+                .unwrap();
+        let link = share::decode(text.trim()).unwrap();
+        assert_eq!(share::model_id_hex(&link.model_id), session.model().id);
+        assert!(link.notes.is_empty(), "{name}: {:?}", link.notes);
+        match (name, &link.plan) {
+            ("v1", LinkPlan::Segments(s)) => assert_eq!(s[0].to, link.tokens.frames()),
+            ("v2", LinkPlan::Planned(plan)) => {
+                assert_eq!(plan.segments.len(), 2);
+                assert_eq!(link.record.as_ref().unwrap().steps.len(), 1);
+            }
+            _ => panic!("{name}: {:?}", link.plan),
+        }
+        let command = Command::Decode {
+            tokens: link.tokens.clone(),
+            plan: link.plan.plan().cloned(),
+        };
+        let outcome = block_on(session.execute(
+            command,
+            &Llm::<coma::agents::llm::UreqTransport>::Off,
+            &mut |_| {},
+        ));
+        let Ok(Outcome::Motion { motion, notes }) = outcome else {
+            panic!("{outcome:?}")
+        };
+        assert!(notes.is_empty(), "{notes:?}");
+        let recorded = recorded_joints(name);
+        assert_eq!(motion.joints.len(), recorded.len(), "{name}");
+        let worst = motion
+            .joints
+            .iter()
+            .zip(&recorded)
+            .flat_map(|(a, b)| a.iter().flatten().zip(b).map(|(x, y)| (x - y).abs()))
+            .fold(0f32, f32::max);
+        assert!(worst < 2e-5, "{name}: joints differ by up to {worst} m");
+    }
+}
