@@ -1,34 +1,13 @@
 //! The one executor the native side needs: the library's async calls (reading tensors back
 //! from a device, the LLM client) are awaited in the page and blocked on natively.
 
-/// Runs a future to completion on the current thread, parking between polls.
+/// Runs a future to completion on the current thread, parking between polls (pollster's).
 ///
 /// Natively, the model's reads from its device and the LLM client's transport complete their
 /// futures synchronously or from another thread, so this is all the executor they need. Not
 /// available on wasm32, where the thread cannot block and the page awaits instead.
 #[cfg(not(target_arch = "wasm32"))]
-pub fn block_on<F: std::future::Future>(future: F) -> F::Output {
-    use std::sync::Arc;
-    use std::task::{Context, Poll, Wake, Waker};
-
-    struct Unparker(std::thread::Thread);
-    impl Wake for Unparker {
-        fn wake(self: Arc<Self>) {
-            self.0.unpark();
-        }
-    }
-
-    let waker = Waker::from(Arc::new(Unparker(std::thread::current())));
-    let mut cx = Context::from_waker(&waker);
-    let mut future = std::pin::pin!(future);
-    loop {
-        if let Poll::Ready(output) = future.as_mut().poll(&mut cx) {
-            return output;
-        }
-        // A spurious wake-up only costs one more poll.
-        std::thread::park();
-    }
-}
+pub use pollster::block_on;
 
 #[cfg(all(test, not(target_arch = "wasm32")))]
 mod tests {

@@ -1,7 +1,30 @@
 //! CoMA in the browser: the core library.
 //!
-//! Motions are 22-joint SMPL skeletons at 20 fps, Y up, metres, starting at the origin facing
-//! +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
+//! Motions are 22-joint SMPL skeletons at 20 fps ([`timing`]), Y up, metres, starting at the
+//! origin facing +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
+//!
+//! The modules in layers; each imports only from the layers below it (a test,
+//! `tests/module_graph.rs`, fails on any cycle):
+//!
+//! ```text
+//!  session                        the engine: typed commands in, progress and outcomes out
+//!  eval  export  train  bench     measuring, assembling and training the networks
+//!  agents                         LLM client, planner, reviewer, the loop (pipeline)
+//!  share  plan                    share links; what the planner hands to the generator
+//!  model  text  trajectory        SPAM, the evaluator, tokens; MiniLM; paths on the ground
+//!  dataset  posecodes  render  bvh  features  skeleton  timing  geom  rng  npy  …
+//! ```
+//!
+//! One prompt, from the text box to the canvas: the page's prompt box sends a
+//! `Command::Run` to the worker (`web/src/messages.rs`, JSON), which hands it to
+//! [`session::Session::execute`]; the engine plans ([`session::planning`]: LLM or built-in
+//! planner, fallbacks, the length asked for), runs the loop ([`agents::pipeline`]: SPAM
+//! generates and edits [`model::tokens::MotionTokens`], the reviewer judges, segments blend),
+//! lays the paths and decodes the joints, reporting [`session::Progress`] on the way; the
+//! worker posts the [`session::Outcome`] back and the page shows it. Every type is checked
+//! once where it enters (a `Plan` and `MotionTokens` as they are deserialised, a share link
+//! as it is decoded) and crosses the later hops as is. `coma run` and `coma eval` call the
+//! same engine.
 
 pub mod agents;
 #[cfg(not(target_arch = "wasm32"))]

@@ -1,5 +1,9 @@
 //! A small seeded random number generator (PCG-XSH-RR 64/32), identical on every platform and in
 //! the page, so a seed reproduces a motion, a training crop or a data split exactly.
+//!
+//! Written by hand rather than taken from `rand`: `rand`'s generators and its distributions
+//! may change their output between versions, and a share link's seed must draw the same
+//! tokens for as long as the link lives.
 
 /// Seeded pseudo-random generator.
 #[derive(Clone, Debug)]

@@ -6,6 +6,10 @@
 //! split on whitespace and punctuation, then split each word greedily into the longest
 //! vocabulary pieces (continuations prefixed `##`; a word that cannot be split becomes
 //! `[UNK]`). The result is framed as `[CLS] … [SEP]` and capped at [`MAX_TOKENS`].
+//!
+//! Written by hand because the `tokenizers` crate builds for wasm32 only behind its unstable
+//! wasm feature and brings a regex engine and every tokenizer family into the page's
+//! download, while this one vocabulary needs only the steps above.
 
 use std::collections::HashMap;
 use unicode_normalization::char::is_combining_mark;

@@ -5,6 +5,10 @@
 //! arithmetic on one variable, with hard limits on its size, so hostile or broken text can at
 //! worst produce an error.
 //!
+//! Written by hand because the expression crates evaluate richer languages (variables,
+//! assignments, user functions, unbounded recursion) whose cost cannot be bounded per call;
+//! here every limit (source length, tokens, nesting, stack depth, operations) is ours.
+//!
 //! # Grammar
 //!
 //! ```text

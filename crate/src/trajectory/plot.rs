@@ -484,3 +484,41 @@ mod tests {
         assert_eq!(nice_step(0.3), 0.5);
     }
 }
+
+#[cfg(test)]
+mod tmp_compare {
+    use super::*;
+    use crate::trajectory::path::resample_curve;
+    use crate::trajectory::shapes::{Shape, Side};
+    #[test]
+    fn tmp_write_compare_pngs() {
+        let tag = std::env::var("PLOTCMP_TAG").unwrap_or_else(|_| "x".into());
+        let path = resample_curve(&Shape::Circle(Side::Right).curve(), 120, 8.0)
+            .unwrap()
+            .points;
+        let reference = resample_curve(&Shape::Circle(Side::Right).curve(), 60, 8.5)
+            .unwrap()
+            .points;
+        for (i, size) in [200u32, 400, 640, 1000, 1500].into_iter().enumerate() {
+            let options = PathPlotOptions {
+                title: if i % 2 == 0 {
+                    "walks in a circle clockwise".into()
+                } else {
+                    String::new()
+                },
+                size_px: size,
+            };
+            let png = path_png(&path, Some(&reference), &options).unwrap();
+            std::fs::write(format!("/tmp/plotcmp/{tag}_ref_{size}.png"), png).unwrap();
+        }
+        let png = path_png(&[[0.3, 0.2]], None, &PathPlotOptions::default()).unwrap();
+        std::fs::write(format!("/tmp/plotcmp/{tag}_point.png"), png).unwrap();
+        let png = path_png(
+            &[[0.0, 0.0], [0.0, 0.0]],
+            Some(&[[-3.0, 120.0], [2.0, -7.5]]),
+            &PathPlotOptions::default(),
+        )
+        .unwrap();
+        std::fs::write(format!("/tmp/plotcmp/{tag}_far.png"), png).unwrap();
+    }
+}

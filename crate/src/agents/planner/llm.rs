@@ -279,7 +279,9 @@ impl DecomposeReply {
         };
         let trajectory = match &self.trajectory {
             None | Some(Value::Null) => None,
-            Some(v) => Some(trajectory_from_reply(v).map_err(|e| format!("trajectory: {e}"))?),
+            Some(v) => {
+                Some(trajectory_from_reply(v.clone()).map_err(|e| format!("trajectory: {e}"))?)
+            }
         };
         Ok(Segment {
             text: text.to_string(),
@@ -327,30 +329,49 @@ fn trajectory_schema() -> Value {
     })
 }
 
+/// A path as a reply writes it: a named shape, or a curve in `t` (models write the ground
+/// plane's second axis as `y` as often as `z`).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum PathReply {
+    Shape(ShapeReply),
+    Curve(CurveReply),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ShapeReply {
+    shape: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CurveReply {
+    x: String,
+    #[serde(alias = "y")]
+    z: String,
+    t0: f64,
+    t1: f64,
+}
+
 /// A path from a reply, checked by the sandboxed evaluator: a shape name from the library,
-/// or formulas that parse within the sandbox's limits and make a walkable curve.
-fn trajectory_from_reply(value: &Value) -> Result<Trajectory, String> {
-    let object = value
-        .as_object()
-        .ok_or("expected an object with \"shape\", or with \"x\", \"z\", \"t0\" and \"t1\"")?;
-    let trajectory = if let Some(name) = object.get("shape") {
-        if object.len() != 1 {
-            return Err("a shape takes no other keys".into());
+/// or formulas that parse within the sandbox's limits and make a walkable curve. (The reply's
+/// `trajectory` is read as a JSON value first, so that a malformed path gets this message
+/// rather than serde's.)
+fn trajectory_from_reply(value: Value) -> Result<Trajectory, String> {
+    let reply: PathReply = serde_json::from_value(value).map_err(|_| {
+        "expected an object with \"shape\" alone, or with \"x\", \"z\", \"t0\" and \"t1\""
+            .to_string()
+    })?;
+    let trajectory = match reply {
+        PathReply::Shape(ShapeReply { shape }) => Trajectory::Shape {
+            shape: Shape::from_name(&shape).ok_or_else(|| {
+                format!("unknown shape (use one of {})", shape_names().join(", "))
+            })?,
+        },
+        PathReply::Curve(CurveReply { x, z, t0, t1 }) => {
+            Trajectory::Curve(CurveSpec { x, z, t0, t1 })
         }
-        let name = name.as_str().ok_or("\"shape\" must be a string")?;
-        let shape = Shape::from_name(name)
-            .ok_or_else(|| format!("unknown shape (use one of {})", shape_names().join(", ")))?;
-        Trajectory::Shape { shape }
-    } else {
-        if let Some(k) = object
-            .keys()
-            .find(|k| !matches!(k.as_str(), "x" | "z" | "y" | "t0" | "t1"))
-        {
-            let k: String = k.chars().take(40).collect();
-            return Err(format!("unexpected key \"{k}\""));
-        }
-        let spec: CurveSpec = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
-        Trajectory::Curve(spec)
     };
     trajectory.validate().map_err(|e| e.to_string())?;
     Ok(trajectory)
