@@ -163,6 +163,7 @@ mod tests {
                 seconds: 4.0,
                 seed: 7,
                 parts: vec![(coma::skeleton::BodyPart::LeftArm, "waves".into())],
+                guidance: None,
             }),
             llm: None,
         };

@@ -14,20 +14,20 @@
 //! that faces +Z; the character's left (+X) is then on the viewer's right, so world +X goes to
 //! the image's right, exactly as your friend's left hand is on your right when you face them.
 
+mod draw;
 pub(crate) mod font;
 pub mod plot;
 
 use std::path::{Path, PathBuf};
 
-use tiny_skia::{
-    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, PixmapPaint, Rect, Stroke,
-    Transform,
-};
+use tiny_skia::{PathBuilder, Pixmap, PixmapPaint, Rect, Stroke, Transform};
 
 use crate::geom::{self, Vec3};
 use crate::skeleton::{joint, BodyPart, Pose, JOINT_NAMES, PARENTS};
 
 use crate::timing::FPS;
+
+use draw::{color, draw_text, fill_circle, paint, stroke_circle, stroke_line, stroke_polyline};
 
 /// Colour of each limb (sRGB). Warm colours are on the character's left and cool ones on its
 /// right, so sides can be told apart at a glance even where the colours are hard to name.
@@ -888,99 +888,9 @@ fn wrap(text: &str, max_width: u32, max_lines: usize) -> Vec<String> {
     lines
 }
 
-fn color(c: [u8; 3], alpha: u8) -> Color {
-    Color::from_rgba8(c[0], c[1], c[2], alpha)
-}
-
-fn paint(c: [u8; 3], alpha: u8) -> Paint<'static> {
-    let mut p = Paint::default();
-    p.set_color_rgba8(c[0], c[1], c[2], alpha);
-    p.anti_alias = true;
-    p
-}
-
 /// A darker version of `c` (`factor` < 1), for joint dots on their own bones.
 fn shade(c: [u8; 3], factor: f32) -> [u8; 3] {
     c.map(|v| (f32::from(v) * factor).round() as u8)
-}
-
-fn round_stroke(width: f32) -> Stroke {
-    Stroke {
-        width,
-        line_cap: LineCap::Round,
-        line_join: LineJoin::Round,
-        ..Stroke::default()
-    }
-}
-
-fn stroke_line(pm: &mut Pixmap, a: (f32, f32), b: (f32, f32), width: f32, c: [u8; 3], alpha: u8) {
-    stroke_polyline(pm, [a, b].into_iter(), width, c, alpha);
-}
-
-/// Strokes a polyline as one path so overlapping segments do not darken each other. Paths
-/// tiny-skia refuses (non-finite or empty) are skipped rather than reported: they cannot
-/// arise from validated poses, and a missing line beats a failed picture.
-fn stroke_polyline(
-    pm: &mut Pixmap,
-    points: impl Iterator<Item = (f32, f32)>,
-    width: f32,
-    c: [u8; 3],
-    alpha: u8,
-) {
-    let mut pb = PathBuilder::new();
-    for (i, (x, y)) in points.enumerate() {
-        if i == 0 {
-            pb.move_to(x, y);
-        } else {
-            pb.line_to(x, y);
-        }
-    }
-    if let Some(path) = pb.finish() {
-        pm.stroke_path(
-            &path,
-            &paint(c, alpha),
-            &round_stroke(width),
-            Transform::identity(),
-            None,
-        );
-    }
-}
-
-fn fill_circle(pm: &mut Pixmap, (x, y): (f32, f32), radius: f32, c: [u8; 3], alpha: u8) {
-    if let Some(path) = PathBuilder::from_circle(x, y, radius) {
-        pm.fill_path(
-            &path,
-            &paint(c, alpha),
-            FillRule::Winding,
-            Transform::identity(),
-            None,
-        );
-    }
-}
-
-fn stroke_circle(pm: &mut Pixmap, (x, y): (f32, f32), radius: f32, width: f32, c: [u8; 3]) {
-    if let Some(path) = PathBuilder::from_circle(x, y, radius) {
-        pm.stroke_path(
-            &path,
-            &paint(c, 255),
-            &round_stroke(width),
-            Transform::identity(),
-            None,
-        );
-    }
-}
-
-/// Draws `text` with the bitmap font, each font pixel an `s`×`s` square, top-left at `(x, y)`.
-/// Squares are snapped to whole pixels and not anti-aliased so that small text stays crisp.
-pub(crate) fn draw_text(pm: &mut Pixmap, text: &str, x: f32, y: f32, s: u32, c: [u8; 3]) {
-    let mut p = paint(c, 255);
-    p.anti_alias = false;
-    let (x, y, s) = (x.round(), y.round(), s as f32);
-    for (col, row) in font::ink(text) {
-        if let Some(rect) = Rect::from_xywh(x + col as f32 * s, y + row as f32 * s, s, s) {
-            pm.fill_rect(rect, &p, Transform::identity(), None);
-        }
-    }
 }
 
 #[cfg(test)]

@@ -41,6 +41,10 @@ pub enum Command {
         seed: u64,
         #[serde(default)]
         parts: Vec<(BodyPart, String)>,
+        /// The base transformer's classifier-free guidance scale, 0 or more (default 4): 1
+        /// follows the learnt conditional distribution, more follows the text harder.
+        #[serde(default)]
+        guidance: Option<f32>,
     },
     /// Frames `from..to` (20 fps) of every part regenerated from `text`. `plan` lays its
     /// segments' paths on the result, as on every command that carries tokens.

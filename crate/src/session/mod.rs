@@ -27,6 +27,7 @@ use crate::agents::reviewer::Scorer;
 use crate::dataset::Vocabulary;
 use crate::features::features_to_joints;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
+use crate::model::motion_model::sampling;
 use crate::model::tokens::MotionTokens;
 use crate::model::MotionModel;
 use crate::plan::Plan;
@@ -154,13 +155,23 @@ impl Session {
                 seconds,
                 seed,
                 parts,
+                guidance,
             } => {
                 if prompt.trim().is_empty() {
                     return Err("type what the person should do first".into());
                 }
+                let mut options = sampling(seed);
+                match guidance {
+                    Some(g) if g.is_finite() && g >= 0.0 => options.base_guidance = g,
+                    Some(g) => {
+                        return Err(format!("the guidance must be 0 or more, not {g}").into())
+                    }
+                    None => {}
+                }
+                let frames = frames_for_seconds(seconds);
                 let tokens = self
                     .model
-                    .generate(&prompt, &parts, frames_for_seconds(seconds), seed)
+                    .generate_with(&prompt, &parts, frames, &options)
                     .await;
                 self.motion_outcome(tokens, None).await
             }

@@ -5,7 +5,8 @@
 //! by the sandboxed [`expr`] language. [`path`] samples it, fits a B-spline, reparametrises it
 //! by arc length and scales it to the motion's own travelled distance; [`root`] rewrites the
 //! root features (angular and linear velocity) so that the rebuilt joints walk it, keeping the
-//! local pose; [`check`] measures the result and [`plot`] draws it.
+//! local pose; [`check`] measures the result, and
+//! [`render::plot::ground_path`](crate::render::plot::ground_path) draws it.
 //!
 //! Conventions: 20 fps, Y up, metres; a motion starts at the origin facing +Z, its left is +X.
 //! "Clockwise" is seen from above (looking down −Y): turning to the walker's right, from +Z
@@ -14,7 +15,6 @@
 pub mod check;
 pub mod expr;
 pub mod path;
-pub mod plot;
 pub mod root;
 pub mod shapes;
 

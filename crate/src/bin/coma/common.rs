@@ -4,9 +4,10 @@
 use anyhow::{bail, Result};
 use clap::Args;
 use coma::agents::llm::{LlmClient, LlmConfig, UreqTransport};
+use coma::executor::block_on;
 use coma::motion_file::write_motion;
 use coma::render::FilmstripOptions;
-use coma::session::Llm;
+use coma::session::{Command, Llm, Motion, Outcome, Session};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -23,6 +24,30 @@ pub fn load_model(dir: &Path) -> Result<coma::model::MotionModel> {
         dir,
         &burn::tensor::Device::flex(),
     )?)
+}
+
+/// The engine with the model in `dir` on the CPU (what did not load is said on stderr).
+pub fn load_session(dir: &Path) -> Result<Session> {
+    let (session, missing) = Session::load(dir, &burn::tensor::Device::flex())?;
+    for m in &missing {
+        eprintln!("note: not loaded: {m}");
+    }
+    Ok(session)
+}
+
+/// Carries out a command that makes a motion without the agents (no LLM), and says on stderr
+/// which paths could not be laid.
+pub fn execute_motion(session: &Session, command: Command) -> Result<Motion> {
+    let outcome = block_on(session.execute(command, &Llm::<UreqTransport>::Off, &mut |_| {}))?;
+    match outcome {
+        Outcome::Motion { motion, notes } => {
+            for n in notes {
+                eprintln!("note: {n}");
+            }
+            Ok(motion)
+        }
+        _ => anyhow::bail!("the engine answered with something other than a motion"),
+    }
 }
 
 /// Writes the motion file and/or filmstrip of generated features.

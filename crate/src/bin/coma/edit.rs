@@ -1,10 +1,10 @@
 //! `coma edit`: a saved motion with a time range or some body parts regenerated.
 
-use crate::common::{load_model, write_outputs, ModelArgs};
+use crate::common::{execute_motion, load_session, write_outputs, ModelArgs};
 use anyhow::{bail, Result};
 use clap::Args;
-use coma::executor::block_on;
 use coma::motion_file::read_motion;
+use coma::session::Command;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -45,7 +45,8 @@ pub fn run(args: EditArgs) -> Result<()> {
         png,
         model,
     } = args;
-    let model = load_model(&model.models)?;
+    let session = load_session(&model.models)?;
+    let model = session.model();
     let motion = match read_motion(&input)? {
         coma::motion_file::MotionData::Features(f) => f,
         _ => bail!(
@@ -54,19 +55,23 @@ pub fn run(args: EditArgs) -> Result<()> {
         ),
     };
     let tokens = model.spam.tokenize(&model.normalizer.normalize(&motion));
-    let edited = match (from, to, parts.is_empty()) {
+    let command = match (from, to, parts.is_empty()) {
         (Some(a), Some(b), true) => {
             let fps = coma::timing::FPS;
-            block_on(model.inbetween(
-                &tokens,
-                &instruction,
-                (a * fps) as usize,
-                (b * fps).ceil() as usize,
+            if !(a.is_finite() && b.is_finite() && a >= 0.0) {
+                bail!("--from and --to are seconds from the start of the motion");
+            }
+            Command::InBetween {
+                tokens,
+                text: instruction.clone(),
+                from: (a * fps) as usize,
+                to: (b * fps).ceil() as usize,
                 seed,
-            ))
+                plan: None,
+            }
         }
         (None, None, false) => {
-            let chosen = parts
+            let parts = parts
                 .iter()
                 .map(|p| {
                     coma::skeleton::BodyPart::parse(p).ok_or_else(|| {
@@ -76,13 +81,16 @@ pub fn run(args: EditArgs) -> Result<()> {
                     })
                 })
                 .collect::<Result<Vec<_>>>()?;
-            // The other parts keep doing what the motion does, as the describer puts it.
-            let rest =
-                coma::posecodes::describe_motion(&coma::features::features_to_joints(&motion));
-            block_on(model.edit_parts(&tokens, &instruction, &chosen, &rest, seed))
+            Command::EditParts {
+                tokens,
+                text: instruction.clone(),
+                parts,
+                seed,
+                plan: None,
+            }
         }
         _ => bail!("give either --from and --to (in-between edit) or --parts (body-part edit)"),
     };
-    let features = block_on(model.features(&edited));
-    write_outputs(&features, Some(&out), png.as_deref(), &instruction)
+    let edited = execute_motion(&session, command)?;
+    write_outputs(&edited.features, Some(&out), png.as_deref(), &instruction)
 }

@@ -1,9 +1,9 @@
 //! `coma generate`: a motion from a prompt.
 
-use crate::common::{load_model, write_outputs, ModelArgs};
-use anyhow::{bail, Result};
+use crate::common::{execute_motion, load_session, write_outputs, ModelArgs};
+use anyhow::Result;
 use clap::Args;
-use coma::executor::block_on;
+use coma::session::Command;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -33,17 +33,17 @@ pub struct GenerateArgs {
 
 pub fn run(args: GenerateArgs) -> Result<()> {
     let parts = parse_parts(&args.parts)?;
-    let model = load_model(&args.model.models)?;
-    let frames = coma::timing::frames_for_seconds(args.seconds);
-    let mut options = coma::model::motion_model::sampling(args.seed);
-    match args.guidance {
-        Some(g) if g.is_finite() && g >= 0.0 => options.base_guidance = g,
-        Some(g) => bail!("--guidance must be a number of 0 or more, not {g}"),
-        None => {}
-    }
-    let tokens = block_on(model.generate_with(&args.prompt, &parts, frames, &options));
+    let session = load_session(&args.model.models)?;
+    let command = Command::Generate {
+        prompt: args.prompt.clone(),
+        seconds: args.seconds,
+        seed: args.seed,
+        parts,
+        guidance: args.guidance,
+    };
+    let motion = execute_motion(&session, command)?;
     write_outputs(
-        &block_on(model.features(&tokens)),
+        &motion.features,
         args.out.as_deref(),
         args.png.as_deref(),
         &args.prompt,

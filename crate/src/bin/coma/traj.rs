@@ -51,11 +51,11 @@ pub fn run(args: TrajArgs) -> Result<()> {
         .validate()
         .and_then(|p| Ok(p.scaled_to(args.length)?.resample(200)?))
         .map_err(|e| anyhow::anyhow!("{}: {e}", trajectory.describe()))?;
-    let options = coma::trajectory::plot::PathPlotOptions {
+    let options = coma::render::plot::PathPlotOptions {
         title: format!("{} ({:.1} m)", trajectory.describe(), args.length),
         ..Default::default()
     };
-    let png = coma::trajectory::plot::path_png(&path.points, None, &options)?;
+    let png = coma::render::plot::path_png(&path.points, None, &options)?;
     std::fs::write(&args.out, png).with_context(|| format!("writing {}", args.out.display()))?;
     if let Trajectory::Shape {
         shape: coma::trajectory::Shape::Circle(side),

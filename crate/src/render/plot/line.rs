@@ -14,23 +14,19 @@
 
 use std::path::Path;
 
-use tiny_skia::{Color, Paint, Pixmap, Rect, Transform};
+use tiny_skia::{Color, Pixmap};
 
+use super::super::draw::{draw_text, draw_text_up, fill_circle, fill_rect, stroke_polyline};
+use super::super::{wrap, RenderError, LABEL_COLOR, MAX_PIXELS, TITLE_COLOR};
 use super::{
-    draw_text, fill_circle, font, stroke_polyline, wrap, RenderError, LABEL_COLOR, MAX_PIXELS,
-    TITLE_COLOR,
+    cap_height, decimal_label, draw_label_centred, draw_label_ending_at, line_height, nice_step,
+    snap_zero, step_exponent, text_width, Area, BLUE, BROWN, GREEN, GRID_COLOR, ORANGE, PURPLE,
+    RED,
 };
 
 /// Colours of the series (sRGB) in order; the seventh series reuses the first colour. They are
 /// the first six colours of Tableau 10, chosen to be told apart on white.
-pub const SERIES_COLORS: [[u8; 3]; 6] = [
-    [31, 119, 180],
-    [255, 127, 14],
-    [44, 160, 44],
-    [214, 39, 40],
-    [148, 103, 189],
-    [140, 86, 75],
-];
+pub const SERIES_COLORS: [[u8; 3]; 6] = [BLUE, ORANGE, GREEN, RED, PURPLE, BROWN];
 
 /// Smallest image that still has room for labels and a plot area.
 const MIN_WIDTH: u32 = 200;
@@ -50,9 +46,11 @@ const TARGET_INTERVALS: f64 = 5.0;
 /// produce absurd tick counts.
 const MAX_TICKS: usize = 50;
 
+/// Colour of the frame round the plot area and of its tick marks.
 const FRAME_COLOR: [u8; 3] = [120, 120, 120];
-const GRID_COLOR: [u8; 3] = [226, 226, 226];
+/// Colour of the unlabelled lines between powers of ten on a logarithmic axis.
 const MINOR_GRID_COLOR: [u8; 3] = [242, 242, 242];
+/// Colour of the axis labels (`x_label`, `y_label`).
 const AXIS_LABEL_COLOR: [u8; 3] = [60, 60, 60];
 
 /// One named curve: (x, y) points, e.g. (training step, loss).
@@ -174,39 +172,6 @@ impl Style {
             line: 1.0 + 0.5 * s,
         }
     }
-
-    /// Width in pixels of `text` drawn at font pixel size `scale`.
-    fn width(text: &str, scale: u32) -> f32 {
-        (font::text_width(text) * scale) as f32
-    }
-
-    fn cap(scale: u32) -> f32 {
-        (font::CAP_ROWS * scale) as f32
-    }
-
-    fn line_height(scale: u32) -> f32 {
-        (font::LINE_ROWS * scale) as f32
-    }
-}
-
-/// A rectangle by its edges, in pixels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Area {
-    left: f32,
-    top: f32,
-    right: f32,
-    bottom: f32,
-}
-
-impl Area {
-    fn shrunk(self, by: f32) -> Area {
-        Area {
-            left: self.left + by,
-            top: self.top + by,
-            right: self.right - by,
-            bottom: self.bottom - by,
-        }
-    }
 }
 
 /// One axis: the range it shows and its ticks, in axis units (log10 of the value on a
@@ -319,31 +284,17 @@ impl Axis {
     }
 }
 
-/// The smallest 1, 2 or 5 × 10^k at least `raw` (which must be positive and finite).
-fn nice_step(raw: f64) -> f64 {
-    let magnitude = 10f64.powf(raw.log10().floor());
-    let normalised = raw / magnitude;
-    // The tolerance keeps e.g. 0.2, whose quotient comes out as 2.0000000000000004, at 2.
-    let factor = [1.0, 2.0, 5.0]
-        .into_iter()
-        .find(|&f| normalised <= f * (1.0 + 1e-9))
-        .unwrap_or(10.0);
-    factor * magnitude
-}
-
 /// Label of linear tick `v` on an axis with ticks `step` apart: just enough digits to tell
 /// neighbouring ticks apart.
 fn linear_label(v: f64, step: f64, scientific: bool) -> String {
-    // Rounding error can leave a tiny or negative-zero value where the tick is 0.
-    let v = if v.abs() < 0.5 * step { 0.0 } else { v };
-    let step_exponent = (step.log10() + 1e-9).floor() as i32;
-    if v == 0.0 && scientific {
+    if !scientific {
+        return decimal_label(v, step);
+    }
+    let v = snap_zero(v, step);
+    if v == 0.0 {
         return "0".to_string();
     }
-    if !scientific {
-        let decimals = (-step_exponent).max(0) as usize;
-        return format!("{v:.decimals$}");
-    }
+    let step_exponent = step_exponent(step);
     let exponent = (v.abs().log10() + 1e-9).floor() as i32;
     let digits = (exponent - step_exponent).max(0) as usize;
     let text = format!("{v:.digits$e}");
@@ -499,37 +450,37 @@ impl Plot {
         let y_label_band = if y_label.is_empty() {
             0.0
         } else {
-            Style::line_height(ts) + style.gap
+            line_height(ts) + style.gap
         };
         let y_tick_width = y
             .ticks
             .iter()
-            .map(|(_, label)| Style::width(label, ts))
+            .map(|(_, label)| text_width(label, ts))
             .fold(0.0, f32::max);
         let left = style.pad + y_label_band + y_tick_width + style.gap + style.tick;
         // The last x label is centred on the frame's right end and must not be cut off.
-        let last_x_label = x.ticks.last().map_or(0.0, |(_, l)| Style::width(l, ts));
+        let last_x_label = x.ticks.last().map_or(0.0, |(_, l)| text_width(l, ts));
         let right = width - style.pad.max(0.5 * last_x_label + style.gap);
 
         let title_bottom = if title.is_empty() {
             style.pad
         } else {
-            style.pad + title.len() as f32 * Style::line_height(ts + 1) + style.gap
+            style.pad + title.len() as f32 * line_height(ts + 1) + style.gap
         };
         let max_legend_rows = (options.height / 150).clamp(1, 4) as usize;
         let legend = legend_items(series, left, right, title_bottom, style, max_legend_rows);
         let legend_bottom = legend
             .iter()
-            .map(|item| item.y + Style::line_height(ts))
+            .map(|item| item.y + line_height(ts))
             .fold(title_bottom, f32::max);
         let top = legend_bottom + style.gap;
 
         let x_label_band = if x_label.is_empty() {
             0.0
         } else {
-            Style::line_height(ts) + style.gap
+            line_height(ts) + style.gap
         };
-        let bottom = height - style.pad - x_label_band - Style::cap(ts) - style.gap - style.tick;
+        let bottom = height - style.pad - x_label_band - cap_height(ts) - style.gap - style.tick;
         let frame = Area {
             left,
             top,
@@ -548,11 +499,11 @@ impl Plot {
         let x_extent = x
             .ticks
             .iter()
-            .map(|(_, l)| Style::width(l, ts))
+            .map(|(_, l)| text_width(l, ts))
             .fold(0.0, f32::max)
             + 3.0 * style.gap;
         let y_positions: Vec<f32> = y.ticks.iter().map(|t| y_px(&y, inner, t.0)).collect();
-        let y_extent = Style::cap(ts) + 2.0 * style.gap;
+        let y_extent = cap_height(ts) + 2.0 * style.gap;
 
         let curves = data
             .iter()
@@ -591,37 +542,13 @@ impl Plot {
         let grid_width = (ts / 2).max(1) as f32;
 
         for &v in &self.y.minor {
-            let py = y_px(&self.y, inner, v);
-            fill_rect(
-                pm,
-                frame.left,
-                py,
-                frame.right - frame.left,
-                1.0,
-                MINOR_GRID_COLOR,
-            );
+            frame.horizontal_rule(pm, y_px(&self.y, inner, v), 1.0, MINOR_GRID_COLOR);
         }
         for &(v, _) in &self.x.ticks {
-            let px = x_px(&self.x, inner, v);
-            fill_rect(
-                pm,
-                px,
-                frame.top,
-                grid_width,
-                frame.bottom - frame.top,
-                GRID_COLOR,
-            );
+            frame.vertical_rule(pm, x_px(&self.x, inner, v), grid_width, GRID_COLOR);
         }
         for &(v, _) in &self.y.ticks {
-            let py = y_px(&self.y, inner, v);
-            fill_rect(
-                pm,
-                frame.left,
-                py,
-                frame.right - frame.left,
-                grid_width,
-                GRID_COLOR,
-            );
+            frame.horizontal_rule(pm, y_px(&self.y, inner, v), grid_width, GRID_COLOR);
         }
 
         for curve in &self.curves {
@@ -634,8 +561,9 @@ impl Plot {
         }
 
         // The frame goes over the curves so that it stays crisp where they approach it.
-        let (w, h) = (frame.right - frame.left, frame.bottom - frame.top);
-        fill_rect(pm, frame.left, frame.top, w, grid_width, FRAME_COLOR);
+        frame.horizontal_rule(pm, frame.top, grid_width, FRAME_COLOR);
+        // The bottom edge reaches under the right edge to close the corner.
+        let w = frame.right - frame.left;
         fill_rect(
             pm,
             frame.left,
@@ -644,17 +572,16 @@ impl Plot {
             grid_width,
             FRAME_COLOR,
         );
-        fill_rect(pm, frame.left, frame.top, grid_width, h, FRAME_COLOR);
-        fill_rect(pm, frame.right, frame.top, grid_width, h, FRAME_COLOR);
+        frame.vertical_rule(pm, frame.left, grid_width, FRAME_COLOR);
+        frame.vertical_rule(pm, frame.right, grid_width, FRAME_COLOR);
 
-        let cap = Style::cap(ts);
+        let cap = cap_height(ts);
         for (i, (v, label)) in self.x.ticks.iter().enumerate() {
             let px = x_px(&self.x, inner, *v);
             fill_rect(pm, px, frame.bottom, grid_width, style.tick, FRAME_COLOR);
             if self.x_labelled.contains(&i) {
-                let tx = px + 0.5 * grid_width - 0.5 * Style::width(label, ts);
                 let ty = frame.bottom + style.tick + style.gap;
-                draw_text(pm, label, tx, ty, ts, LABEL_COLOR);
+                draw_label_centred(pm, label, px + 0.5 * grid_width, ty, ts, LABEL_COLOR);
             }
         }
         for (i, (v, label)) in self.y.ticks.iter().enumerate() {
@@ -668,20 +595,19 @@ impl Plot {
                 FRAME_COLOR,
             );
             if self.y_labelled.contains(&i) {
-                let tx = frame.left - style.tick - style.gap - Style::width(label, ts);
-                let ty = py + 0.5 * grid_width - 0.5 * cap;
-                draw_text(pm, label, tx, ty, ts, LABEL_COLOR);
+                let right = frame.left - style.tick - style.gap;
+                let middle = py + 0.5 * grid_width;
+                draw_label_ending_at(pm, label, right, middle, ts, LABEL_COLOR);
             }
         }
 
         let frame_centre_x = 0.5 * (frame.left + frame.right);
         if !self.x_label.is_empty() {
-            let tx = frame_centre_x - 0.5 * Style::width(&self.x_label, ts);
             let ty = frame.bottom + style.tick + style.gap + cap + style.gap + style.gap;
-            draw_text(pm, &self.x_label, tx, ty, ts, AXIS_LABEL_COLOR);
+            draw_label_centred(pm, &self.x_label, frame_centre_x, ty, ts, AXIS_LABEL_COLOR);
         }
         if !self.y_label.is_empty() {
-            let bottom = 0.5 * (frame.top + frame.bottom) + 0.5 * Style::width(&self.y_label, ts);
+            let bottom = 0.5 * (frame.top + frame.bottom) + 0.5 * text_width(&self.y_label, ts);
             draw_text_up(pm, &self.y_label, style.pad, bottom, ts, AXIS_LABEL_COLOR);
         }
 
@@ -731,8 +657,8 @@ fn title_lines(title: &str, width: u32, style: Style) -> Vec<(String, f32, f32)>
         .into_iter()
         .enumerate()
         .map(|(i, line)| {
-            let x = 0.5 * (width as f32 - Style::width(&line, scale));
-            let y = style.pad + i as f32 * Style::line_height(scale);
+            let x = 0.5 * (width as f32 - text_width(&line, scale));
+            let y = style.pad + i as f32 * line_height(scale);
             (line, x, y)
         })
         .collect()
@@ -771,7 +697,7 @@ fn legend_items(
         let Some(text) = wrap(name, max_text, 1).into_iter().next() else {
             continue;
         };
-        let item_width = swatch + Style::width(&text, ts);
+        let item_width = swatch + text_width(&text, ts);
         if rows.is_empty() || (x > left && x + item_width > right) {
             if rows.len() == max_rows {
                 break;
@@ -779,7 +705,7 @@ fn legend_items(
             rows.push(Vec::new());
             x = left;
         }
-        let y = top + (rows.len() - 1) as f32 * Style::line_height(ts);
+        let y = top + (rows.len() - 1) as f32 * line_height(ts);
         let row = rows.last_mut().expect("a row was just ensured");
         row.push((
             item_width,
@@ -814,36 +740,9 @@ fn draw_no_data(pm: &mut Pixmap, options: &PlotOptions) {
         scale,
     );
     let message = "no data";
-    let x = 0.5 * (options.width as f32 - Style::width(message, scale));
-    let y = 0.5 * (options.height as f32 - Style::cap(scale));
+    let x = 0.5 * (options.width as f32 - text_width(message, scale));
+    let y = 0.5 * (options.height as f32 - cap_height(scale));
     draw_text(pm, message, x, y, scale, LABEL_COLOR);
-}
-
-/// A filled rectangle snapped to whole pixels and not anti-aliased, so that grid lines and
-/// the frame stay sharp.
-fn fill_rect(pm: &mut Pixmap, x: f32, y: f32, w: f32, h: f32, c: [u8; 3]) {
-    let mut paint = Paint::default();
-    paint.set_color_rgba8(c[0], c[1], c[2], 255);
-    paint.anti_alias = false;
-    let (x, y) = (x.round(), y.round());
-    if let Some(rect) = Rect::from_xywh(x, y, w.round().max(1.0), h.round().max(1.0)) {
-        pm.fill_rect(rect, &paint, Transform::identity(), None);
-    }
-}
-
-/// Draws `text` turned a quarter turn anticlockwise (read bottom to top), as a y axis label:
-/// the glyph tops face left towards `x` and the text starts at `bottom`.
-fn draw_text_up(pm: &mut Pixmap, text: &str, x: f32, bottom: f32, s: u32, c: [u8; 3]) {
-    let mut paint = Paint::default();
-    paint.set_color_rgba8(c[0], c[1], c[2], 255);
-    paint.anti_alias = false;
-    let (x, bottom, s) = (x.round(), bottom.round(), s as f32);
-    for (col, row) in font::ink(text) {
-        let rect = Rect::from_xywh(x + row as f32 * s, bottom - (col + 1) as f32 * s, s, s);
-        if let Some(rect) = rect {
-            pm.fill_rect(rect, &paint, Transform::identity(), None);
-        }
-    }
 }
 
 #[cfg(test)]

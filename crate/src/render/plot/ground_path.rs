@@ -1,5 +1,5 @@
-//! Top-down pictures of ground paths, as PNG bytes: the path a motion walks, optionally over
-//! the curve that was asked for.
+//! Top-down pictures of ground paths, as PNG bytes: the path a motion walks (as planned by
+//! [`trajectory`](crate::trajectory)), optionally over the curve that was asked for.
 //!
 //! The view is from above (looking down −Y) with world +Z pointing up the image. Seen from
 //! above, +X is then on the image's *left* (as on a map read from behind the walker, whose
@@ -10,20 +10,28 @@
 //!
 //! Text uses the filmstrips' bitmap font ([`render`](crate::render)).
 
-use crate::render::{draw_text, font, font::text_width};
-use tiny_skia::{
-    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, StrokeDash, Transform,
+use tiny_skia::{Color, Pixmap, StrokeDash};
+
+use super::super::draw::{
+    draw_text, fill_circle, fill_polygon, round_stroke, stroke_polyline, stroke_polyline_with,
+};
+use super::{
+    decimal_label, draw_label_centred, draw_label_ending_at, line_height, nice_step, Area, BLUE,
+    GREEN, GRID_COLOR, RED,
 };
 
 /// Largest coordinate accepted, metres: a walking path is never this far from its start.
 pub const MAX_COORD_M: f64 = 1.0e4;
 
-const PATH_COLOR: [u8; 3] = [31, 119, 180];
+/// Colours (sRGB) of the walked path, its start dot and its end arrowhead.
+const PATH_COLOR: [u8; 3] = BLUE;
+const START_COLOR: [u8; 3] = GREEN;
+const END_COLOR: [u8; 3] = RED;
+/// Colour of the requested curve, drawn dashed under the path.
 const REFERENCE_COLOR: [u8; 3] = [150, 150, 150];
-const START_COLOR: [u8; 3] = [44, 160, 44];
-const END_COLOR: [u8; 3] = [214, 39, 40];
-const GRID_COLOR: [u8; 3] = [225, 225, 225];
+/// Colour of the grid lines through the origin (x = 0 and z = 0); the others are lighter.
 const AXIS_COLOR: [u8; 3] = [170, 170, 170];
+/// Colours of the title, and of the coordinates and the legend line.
 const TEXT_COLOR: [u8; 3] = [40, 40, 40];
 const LABEL_COLOR: [u8; 3] = [110, 110, 110];
 
@@ -90,7 +98,7 @@ pub fn path_png(
 
     let s = (size / 320).clamp(1, 4);
     let sf = s as f32;
-    let line_h = font::LINE_ROWS as f32 * sf;
+    let line_h = line_height(s);
     let pad = 10.0 * sf;
     let top = pad
         + if options.title.is_empty() {
@@ -110,20 +118,12 @@ pub fn path_png(
     if let Some(r) = reference {
         let mut stroke = round_stroke(1.5 * sf);
         stroke.dash = StrokeDash::new(vec![6.0 * sf, 4.0 * sf], 0.0);
-        stroke_polyline(
-            &mut pm,
-            r.iter().map(|p| view.pixel(*p)),
-            &stroke,
-            REFERENCE_COLOR,
-        );
+        let points = r.iter().map(|p| view.pixel(*p));
+        stroke_polyline_with(&mut pm, points, &stroke, REFERENCE_COLOR, 255);
     }
-    stroke_polyline(
-        &mut pm,
-        path.iter().map(|p| view.pixel(*p)),
-        &round_stroke(2.5 * sf),
-        PATH_COLOR,
-    );
-    fill_circle(&mut pm, view.pixel(path[0]), 5.0 * sf, START_COLOR);
+    let points = path.iter().map(|p| view.pixel(*p));
+    stroke_polyline(&mut pm, points, 2.5 * sf, PATH_COLOR, 255);
+    fill_circle(&mut pm, view.pixel(path[0]), 5.0 * sf, START_COLOR, 255);
     draw_arrowhead(&mut pm, path, &view, 9.0 * sf);
 
     if !options.title.is_empty() {
@@ -133,7 +133,7 @@ pub fn path_png(
     }
     let legend = format!(
         "VIEW FROM ABOVE, +Z UP, +X LEFT. GRID {} M",
-        format_tick(view.step, view.step)
+        decimal_label(view.step, view.step)
     );
     draw_text(
         &mut pm,
@@ -154,14 +154,6 @@ fn check_points(points: &[[f64; 2]], which: &'static str) -> Result<(), PlotErro
         Some(index) => Err(PlotError::BadPoint { which, index }),
         None => Ok(()),
     }
-}
-
-#[derive(Clone, Copy, Debug)]
-struct Area {
-    left: f32,
-    top: f32,
-    right: f32,
-    bottom: f32,
 }
 
 /// The mapping from metres to pixels: one scale for both axes, so shapes keep their
@@ -222,72 +214,31 @@ impl View {
     }
 }
 
-/// The smallest 1, 2 or 5 × 10^k at least `raw` (positive).
-fn nice_step(raw: f64) -> f64 {
-    let magnitude = 10f64.powf(raw.log10().floor());
-    let normalised = raw / magnitude;
-    let factor = [1.0, 2.0, 5.0]
-        .into_iter()
-        .find(|&f| normalised <= f * (1.0 + 1e-9))
-        .unwrap_or(10.0);
-    factor * magnitude
-}
-
-fn format_tick(v: f64, step: f64) -> String {
-    let v = if v.abs() < 0.5 * step { 0.0 } else { v };
-    let decimals = (-(step.log10() + 1e-9).floor()).max(0.0) as usize;
-    format!("{v:.decimals$}")
-}
-
+/// Grid lines every `view.step` metres across `area`, the lines through the origin darker,
+/// with their coordinates under the area (x) and left of it (z).
 fn draw_grid(pm: &mut Pixmap, view: &View, area: &Area, s: u32) {
     let sf = s as f32;
     let [x0, x1, z0, z1] = view.bounds;
     let step = view.step;
-    let thin = round_stroke(1.0);
     // Bounded by the view: the extent is about six steps, so at most a dozen lines each way.
-    let first = |lo: f64| (lo / step).ceil() as i64;
-    let last = |hi: f64| (hi / step).floor() as i64;
-    for i in first(x0)..=last(x1) {
-        let x = i as f64 * step;
+    let ticks = |lo: f64, hi: f64| {
+        ((lo / step).ceil() as i64..=(hi / step).floor() as i64).map(move |i| {
+            let color = if i == 0 { AXIS_COLOR } else { GRID_COLOR };
+            (i as f64 * step, color)
+        })
+    };
+    // The lines are one pixel wide, centred on the coordinate's pixel.
+    for (x, color) in ticks(x0, x1) {
         let (px, _) = view.pixel([x, 0.0]);
-        let color = if i == 0 { AXIS_COLOR } else { GRID_COLOR };
-        stroke_polyline(
-            pm,
-            [(px, area.top), (px, area.bottom)].into_iter(),
-            &thin,
-            color,
-        );
-        let label = format_tick(x, step);
-        let w = text_width(&label) as f32 * sf;
-        draw_text(
-            pm,
-            &label,
-            px - w / 2.0,
-            area.bottom + 3.0 * sf,
-            s,
-            LABEL_COLOR,
-        );
+        area.vertical_rule(pm, px - 0.5, 1.0, color);
+        let label = decimal_label(x, step);
+        draw_label_centred(pm, &label, px, area.bottom + 3.0 * sf, s, LABEL_COLOR);
     }
-    for i in first(z0)..=last(z1) {
-        let z = i as f64 * step;
+    for (z, color) in ticks(z0, z1) {
         let (_, py) = view.pixel([0.0, z]);
-        let color = if i == 0 { AXIS_COLOR } else { GRID_COLOR };
-        stroke_polyline(
-            pm,
-            [(area.left, py), (area.right, py)].into_iter(),
-            &thin,
-            color,
-        );
-        let label = format_tick(z, step);
-        let w = text_width(&label) as f32 * sf;
-        draw_text(
-            pm,
-            &label,
-            area.left - w - 3.0 * sf,
-            py - font::CAP_ROWS as f32 / 2.0 * sf,
-            s,
-            LABEL_COLOR,
-        );
+        area.horizontal_rule(pm, py - 0.5, 1.0, color);
+        let label = decimal_label(z, step);
+        draw_label_ending_at(pm, &label, area.left - 3.0 * sf, py, s, LABEL_COLOR);
     }
 }
 
@@ -299,7 +250,7 @@ fn draw_arrowhead(pm: &mut Pixmap, path: &[[f64; 2]], view: &View, length: f32) 
         .rev()
         .find(|p| (p[0] - end[0]).hypot(p[1] - end[1]) > 1e-3)
     else {
-        fill_circle(pm, view.pixel(end), length / 2.0, END_COLOR);
+        fill_circle(pm, view.pixel(end), length / 2.0, END_COLOR, 255);
         return;
     };
     let (ex, ey) = view.pixel(end);
@@ -307,74 +258,18 @@ fn draw_arrowhead(pm: &mut Pixmap, path: &[[f64; 2]], view: &View, length: f32) 
     let (dx, dy) = (ex - fx, ey - fy);
     let n = dx.hypot(dy);
     if n <= 0.0 {
-        fill_circle(pm, (ex, ey), length / 2.0, END_COLOR);
+        fill_circle(pm, (ex, ey), length / 2.0, END_COLOR, 255);
         return;
     }
     let (ux, uy) = (dx / n, dy / n);
     let (bx, by) = (ex - ux * length, ey - uy * length);
     let half = length * 0.5;
-    let mut pb = PathBuilder::new();
-    pb.move_to(ex + ux * half * 0.3, ey + uy * half * 0.3);
-    pb.line_to(bx - uy * half, by + ux * half);
-    pb.line_to(bx + uy * half, by - ux * half);
-    pb.close();
-    if let Some(p) = pb.finish() {
-        pm.fill_path(
-            &p,
-            &paint(END_COLOR),
-            FillRule::Winding,
-            Transform::identity(),
-            None,
-        );
-    }
-}
-
-fn paint(c: [u8; 3]) -> Paint<'static> {
-    let mut p = Paint::default();
-    p.set_color_rgba8(c[0], c[1], c[2], 255);
-    p.anti_alias = true;
-    p
-}
-
-fn round_stroke(width: f32) -> Stroke {
-    Stroke {
-        width,
-        line_cap: LineCap::Round,
-        line_join: LineJoin::Round,
-        ..Stroke::default()
-    }
-}
-
-fn stroke_polyline(
-    pm: &mut Pixmap,
-    points: impl Iterator<Item = (f32, f32)>,
-    stroke: &Stroke,
-    c: [u8; 3],
-) {
-    let mut pb = PathBuilder::new();
-    for (i, (x, y)) in points.enumerate() {
-        if i == 0 {
-            pb.move_to(x, y);
-        } else {
-            pb.line_to(x, y);
-        }
-    }
-    // A single point makes no path; tiny-skia returns None and nothing is drawn.
-    if let Some(path) = pb.finish() {
-        pm.stroke_path(&path, &paint(c), stroke, Transform::identity(), None);
-    }
-}
-
-fn fill_circle(pm: &mut Pixmap, (x, y): (f32, f32), r: f32, c: [u8; 3]) {
-    if let Some(path) = PathBuilder::from_circle(x, y, r) {
-        pm.fill_path(
-            &path,
-            &paint(c),
-            FillRule::Winding,
-            Transform::identity(),
-            None,
-        );
-    }
+    let tip = (ex + ux * half * 0.3, ey + uy * half * 0.3);
+    let corners = [
+        (bx - uy * half, by + ux * half),
+        (bx + uy * half, by - ux * half),
+    ];
+    fill_polygon(pm, &[tip, corners[0], corners[1]], END_COLOR, 255);
 }
 
 #[cfg(test)]
@@ -475,50 +370,5 @@ mod tests {
             path_png(&[[0.0, 0.0]], None, &tiny),
             Err(PlotError::BadSize(10))
         );
-    }
-
-    #[test]
-    fn ticks_are_short_and_steps_nice() {
-        assert_eq!(format_tick(0.5, 0.5), "0.5");
-        assert_eq!(format_tick(-2.0, 1.0), "-2");
-        assert_eq!(nice_step(0.3), 0.5);
-    }
-}
-
-#[cfg(test)]
-mod tmp_compare {
-    use super::*;
-    use crate::trajectory::path::resample_curve;
-    use crate::trajectory::shapes::{Shape, Side};
-    #[test]
-    fn tmp_write_compare_pngs() {
-        let tag = std::env::var("PLOTCMP_TAG").unwrap_or_else(|_| "x".into());
-        let path = resample_curve(&Shape::Circle(Side::Right).curve(), 120, 8.0)
-            .unwrap()
-            .points;
-        let reference = resample_curve(&Shape::Circle(Side::Right).curve(), 60, 8.5)
-            .unwrap()
-            .points;
-        for (i, size) in [200u32, 400, 640, 1000, 1500].into_iter().enumerate() {
-            let options = PathPlotOptions {
-                title: if i % 2 == 0 {
-                    "walks in a circle clockwise".into()
-                } else {
-                    String::new()
-                },
-                size_px: size,
-            };
-            let png = path_png(&path, Some(&reference), &options).unwrap();
-            std::fs::write(format!("/tmp/plotcmp/{tag}_ref_{size}.png"), png).unwrap();
-        }
-        let png = path_png(&[[0.3, 0.2]], None, &PathPlotOptions::default()).unwrap();
-        std::fs::write(format!("/tmp/plotcmp/{tag}_point.png"), png).unwrap();
-        let png = path_png(
-            &[[0.0, 0.0], [0.0, 0.0]],
-            Some(&[[-3.0, 120.0], [2.0, -7.5]]),
-            &PathPlotOptions::default(),
-        )
-        .unwrap();
-        std::fs::write(format!("/tmp/plotcmp/{tag}_far.png"), png).unwrap();
     }
 }
