@@ -3,7 +3,8 @@
 //! wasm-bindgen-test-runner, as `wasm-pack test --headless --chrome` would).
 #![cfg(target_arch = "wasm32")]
 
-use coma::share::{decode, encode, Edit, EditKind, SharedMotion};
+use coma::model::tokens::MotionTokens;
+use coma::share::{decode, encode, Edit, EditKind, LinkPlan, LinkSegment, RunRecord, SharedMotion};
 use wasm_bindgen_test::*;
 
 wasm_bindgen_test_configure!(run_in_browser);
@@ -13,8 +14,15 @@ fn sample() -> SharedMotion {
         model_id: *b"\x01\x23\x45\x67\x89\xab\xcd\xef",
         seed: 42,
         prompt: "a person walks forward, then bows".into(),
-        plan: r#"{"segments": []}"#.into(),
-        record: r#"{"steps": ["segment 1: generated"]}"#.into(),
+        plan: LinkPlan::Segments(vec![LinkSegment {
+            text: "a person walks forward".into(),
+            from: 0,
+            to: 80,
+        }]),
+        record: Some(RunRecord {
+            steps: vec!["segment 1: generated".into()],
+            ..Default::default()
+        }),
         history: vec![Edit {
             kind: EditKind::Generate,
             text: "a person walks forward".into(),
@@ -23,13 +31,17 @@ fn sample() -> SharedMotion {
             parts: 0,
             seed: 42,
         }],
-        tokens: (0..4)
-            .map(|p| {
-                (0..4)
-                    .map(|l| (0..20).map(|s| (p * 97 + l * 13 + s) % 512).collect())
-                    .collect()
-            })
-            .collect(),
+        tokens: MotionTokens::new(
+            (0..4)
+                .map(|p| {
+                    (0..4)
+                        .map(|l| (0..20).map(|s| (p * 97 + l * 13 + s) % 512).collect())
+                        .collect()
+                })
+                .collect(),
+        )
+        .unwrap(),
+        notes: Vec::new(),
     }
 }
 
