@@ -123,12 +123,9 @@ impl Session {
     ) -> Result<Outcome, SessionError> {
         match command {
             Command::Plan { prompt, seconds } => {
-                let embed = |s: &str| self.embed(s);
-                let context = PlanningContext {
-                    vocabulary: self.vocabulary.as_ref(),
-                    embed: Some(&embed),
-                };
-                let plan = plan_prompt(&prompt, seconds, llm, &context, progress).await?;
+                let mut steps = Steps::new(progress);
+                let plan = self.plan(&prompt, None, seconds, llm, &mut steps).await?;
+                steps.report(Progress::Planned { plan: plan.clone() });
                 Ok(Outcome::Plan { plan })
             }
             Command::Run {
@@ -219,6 +216,23 @@ impl Session {
         }
     }
 
+    /// The plan of `prompt` (or `given`) with this session's vocabulary and sentence encoder.
+    async fn plan<T: Transport>(
+        &self,
+        prompt: &str,
+        given: Option<Plan>,
+        seconds: Option<f64>,
+        llm: &Llm<'_, T>,
+        steps: &mut Steps<'_>,
+    ) -> Result<Plan, SessionError> {
+        let embed = |s: &str| self.embed(s);
+        let context = PlanningContext {
+            vocabulary: self.vocabulary.as_ref(),
+            embed: Some(&embed),
+        };
+        planning::plan_with(prompt, given, seconds, llm, &context, steps).await
+    }
+
     /// Plans (unless a plan is given), then runs the loop and decodes the motion.
     async fn run<T: Transport>(
         &self,
@@ -230,25 +244,7 @@ impl Session {
         progress: &mut dyn FnMut(Progress),
     ) -> Result<RunOutcome, SessionError> {
         let mut steps = Steps::new(progress);
-        let plan = match given {
-            Some(mut plan) => {
-                if let Some(seconds) = seconds {
-                    plan.fit_seconds(seconds);
-                }
-                for event in progress::plan_events(&plan) {
-                    steps.step(progress::plan_event_line(&event));
-                }
-                plan
-            }
-            None => {
-                let embed = |s: &str| self.embed(s);
-                let context = PlanningContext {
-                    vocabulary: self.vocabulary.as_ref(),
-                    embed: Some(&embed),
-                };
-                planning::plan_with(prompt, seconds, llm, &context, &mut steps).await?
-            }
-        };
+        let plan = self.plan(prompt, given, seconds, llm, &mut steps).await?;
         steps.report(Progress::Planned { plan: plan.clone() });
         steps.expect(run_steps(&plan, options.rounds));
         let scorer = self.scorer();

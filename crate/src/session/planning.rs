@@ -27,31 +27,35 @@ pub async fn plan_prompt<T: Transport>(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Plan, SessionError> {
     let mut steps = Steps::new(progress);
-    let plan = plan_with(prompt, seconds, llm, context, &mut steps).await?;
+    let plan = plan_with(prompt, None, seconds, llm, context, &mut steps).await?;
     steps.report(Progress::Planned { plan: plan.clone() });
     Ok(plan)
 }
 
+/// The plan of a run: `given` (a link's, say) as it is, else the prompt's from the planner;
+/// then fitted to `seconds` and reported step by step.
 pub(super) async fn plan_with<T: Transport>(
     prompt: &str,
+    given: Option<Plan>,
     seconds: Option<f64>,
     llm: &Llm<'_, T>,
     context: &PlanningContext<'_>,
     steps: &mut Steps<'_>,
 ) -> Result<Plan, SessionError> {
-    if prompt.trim().is_empty() {
+    if given.is_none() && prompt.trim().is_empty() {
         return Err("type what the person should do first".into());
     }
     let mut fallback_note = None;
-    let mut plan = match (llm, context.vocabulary) {
-        (Llm::On(client), Some(vocabulary)) => {
+    let mut plan = match (given, llm, context.vocabulary) {
+        (Some(plan), _, _) => plan,
+        (None, Llm::On(client), Some(vocabulary)) => {
             steps.step(format!("planning with {}…", client.config().model));
             planner::llm::plan(client, prompt, vocabulary, context.embed, &mut |event| {
                 steps.step(plan_event_line(event))
             })
             .await
         }
-        (llm, _) => {
+        (None, llm, _) => {
             fallback_note = match llm {
                 Llm::On(_) => Some(
                     "the model's vocabulary did not load, so the built-in planner planned".into(),
