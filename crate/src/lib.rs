@@ -43,6 +43,7 @@ pub mod motion_file;
 pub mod npy;
 pub mod plan;
 pub mod posecodes;
+pub mod posture;
 pub mod render;
 pub mod rng;
 pub mod serve;

@@ -2,7 +2,7 @@
 
 use crate::geom::{self, Vec3};
 use crate::skeleton::{joint, Pose};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 const UP: Vec3 = [0.0, 1.0, 0.0];
 
@@ -186,7 +186,7 @@ pub(super) fn joint_angle_deg(a: Vec3, b: Vec3, c: Vec3) -> f64 {
 }
 
 /// How bent a knee or elbow is, from the inner angle between its two bones.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Bend {
     /// Inner angle above [`STRAIGHT_MIN_DEG`] (160°).
@@ -200,6 +200,14 @@ pub enum Bend {
 }
 
 impl Bend {
+    /// Every category, from the first to the last.
+    pub const ALL: [Bend; 4] = [
+        Bend::Straight,
+        Bend::SlightlyBent,
+        Bend::PartiallyBent,
+        Bend::CompletelyBent,
+    ];
+
     /// The category of an inner joint angle in degrees (180 = fully extended).
     pub fn from_angle(deg: f64) -> Bend {
         if deg > STRAIGHT_MIN_DEG {
@@ -225,7 +233,7 @@ impl Bend {
 }
 
 /// How far apart two joints are.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Distance {
     /// Under [`CLOSE_MAX_M`] (0.15 m): touching or nearly.
@@ -239,6 +247,14 @@ pub enum Distance {
 }
 
 impl Distance {
+    /// Every category, from the first to the last.
+    pub const ALL: [Distance; 4] = [
+        Distance::Close,
+        Distance::ShoulderWidth,
+        Distance::Spread,
+        Distance::Wide,
+    ];
+
     /// The category of a distance in metres.
     pub fn from_metres(d: f64) -> Distance {
         if d < CLOSE_MAX_M {
@@ -369,7 +385,7 @@ impl Side {
 
 /// Orientation of a bone (upper arm, forearm, thigh, shin) by its angle to the vertical; up and
 /// down are not told apart (heights say that).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Orientation {
     /// Within [`VERTICAL_MAX_DEG`] (25°) of the vertical.
@@ -381,6 +397,13 @@ pub enum Orientation {
 }
 
 impl Orientation {
+    /// Every category, from the first to the last.
+    pub const ALL: [Orientation; 3] = [
+        Orientation::Vertical,
+        Orientation::Diagonal,
+        Orientation::Horizontal,
+    ];
+
     /// The category of a bone vector (child joint minus parent joint).
     pub fn of(bone: Vec3) -> Orientation {
         let n = geom::norm(bone);

@@ -19,6 +19,7 @@
 //! directions such as "in front" or "to the left" are judged in the body frame of each frame
 //! (see [`facing`]), so they do not depend on where the character faces in the world.
 
+mod body;
 mod frame;
 mod motion;
 mod text;
@@ -26,6 +27,12 @@ mod text;
 #[cfg(test)]
 mod tests;
 
+pub use body::{
+    angle_from_vertical_deg, body_level, relative_offset, torso_in_hip_frame, torso_lean,
+    torso_twist, torso_twist_deg, BodyPoint, Lean, Limb, PelvisLevel, Relation, Support, Twist,
+    CROUCH_PELVIS_M, HAND_CONTACT_M, LYING_MIN_DEG, LYING_PELVIS_M, PELVIS_CONTACT_M,
+    PLANK_PELVIS_M, TWIST_MIN_DEG, UPRIGHT_MAX_DEG,
+};
 pub use frame::{
     facing, floor_height, frame_codes, ArmCodes, Bend, Depth, Distance, FrameCodes, LegCodes,
     Orientation, Side, Vertical, CLOSE_MAX_M, DEPTH_BAND_M, FOOT_CONTACT_M, HEIGHT_BAND_M,

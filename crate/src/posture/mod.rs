@@ -1,0 +1,15 @@
+//! Key postures (PRO-Motion's plan–posture–go, design §4.5): poses and actions the motion model
+//! never saw in its data (a T-pose, a squat, kneeling, a superhero landing, crawling), built
+//! from closed-vocabulary posture scripts instead of learned from motion capture.
+//!
+//! - [`script`]: a key pose as constraints in the describer's vocabulary, parsed and checked.
+//! - [`go`]: key poses placed in time — eased transitions, planted feet, flight for jumps,
+//!   turns and cycles — into a motion at 20 fps.
+
+pub mod check;
+pub mod go;
+pub mod script;
+pub mod solver;
+
+#[cfg(test)]
+mod tests;
