@@ -8,6 +8,7 @@
 
 pub mod check;
 pub mod go;
+pub mod library;
 pub mod script;
 pub mod solver;
 

@@ -619,9 +619,23 @@ fn distance_outside_hull(q: [f64; 2], points: &mut [[f64; 2]]) -> f64 {
 
 /// Weight of the balance term per squared metre outside the support.
 const BALANCE_WEIGHT: f64 = 40.0;
-/// Weight of the prior per squared radian away from the starting pose: small, so it only
-/// decides what the script leaves open.
-const PRIOR_WEIGHT: f64 = 0.02;
+/// Weight of the prior per squared radian away from the starting pose, per angle: small next
+/// to a missed constraint (1 per 10° or 5 cm outside its band), so it decides what the script
+/// leaves open; tipping the whole body or bending the spine costs more than moving a limb, so
+/// that a script about the arms does not lean the body to reach them.
+const PRIOR_WEIGHT: [f64; NUM_ANGLES] = {
+    let mut w = [0.05; NUM_ANGLES];
+    w[angle::PITCH] = 1.0;
+    w[angle::ROLL] = 1.0;
+    w[angle::SPINE_BEND] = 0.5;
+    w[angle::SPINE_SIDE] = 0.5;
+    w[angle::SPINE_TWIST] = 0.5;
+    w[angle::HEAD] = 0.3;
+    w
+};
+/// Weight per squared radian of difference between the left and the right limb's angles:
+/// people stand, squat and kneel symmetrically unless asked otherwise.
+const SYMMETRY_WEIGHT: f64 = 0.05;
 
 fn cost(script: &PostureScript, weights: &[f64], a: &Angles, prior: &Angles) -> f64 {
     let pose = pose_of(a);
@@ -632,8 +646,17 @@ fn cost(script: &PostureScript, weights: &[f64], a: &Angles, prior: &Angles) -> 
         .map(|(c, w)| w * violation(c, &pose))
         .sum();
     let balance = BALANCE_WEIGHT * imbalance_m(&pose).powi(2);
-    let prior_cost: f64 = a.iter().zip(prior).map(|(x, p)| (x - p) * (x - p)).sum();
-    constraints + balance + PRIOR_WEIGHT * prior_cost
+    let prior_cost: f64 = a
+        .iter()
+        .zip(prior)
+        .zip(PRIOR_WEIGHT)
+        .map(|((x, p), w)| w * (x - p) * (x - p))
+        .sum();
+    let asymmetry: f64 = (0..5)
+        .map(|i| (a[angle::LEFT_LEG + i] - a[angle::RIGHT_LEG + i]).powi(2))
+        .chain((0..4).map(|i| (a[angle::LEFT_ARM + i] - a[angle::RIGHT_ARM + i]).powi(2)))
+        .sum();
+    constraints + balance + prior_cost + SYMMETRY_WEIGHT * asymmetry
 }
 
 /// A solved key pose.

@@ -17,6 +17,7 @@ mod export;
 mod features;
 mod generate;
 mod plan;
+mod posture;
 mod probe;
 mod render;
 mod run;
@@ -53,6 +54,9 @@ enum Command {
     Generate(generate::GenerateArgs),
     /// Plan a prompt (segments, base motions, part edits, paths) without generating.
     Plan(plan::PlanArgs),
+    /// Key postures: solve a named posture or a script (`coma posture T-pose --png t.png`),
+    /// `check` the solver, `list` the library.
+    Posture(posture::PostureArgs),
     /// The whole CoMA loop: plan, generate, edit, review, blend and lay the paths.
     Run(run::RunArgs),
     /// Draw the root path a phrase or an expression curve asks for, as a PNG.
@@ -94,6 +98,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         Command::Train(args) => train::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Plan(args) => plan::run(args),
+        Command::Posture(args) => posture::run(args),
         Command::Run(args) => run::run(args),
         Command::Traj(args) => traj::run(args),
         Command::Edit(args) => edit::run(args),
