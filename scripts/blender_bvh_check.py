@@ -27,5 +27,16 @@ for f in range(frames):
         r = ref["frames"][f][j]
         worst = max(worst, math.dist(q, r))
 print(f"blender import: frames={frames} bones={len(arm.pose.bones)} fps={scene.render.fps} worst_mm={worst*1000:.3f}")
+# How much each bone's length varies over the motion (the JSON is rounded to 0.1 mm): a
+# skeleton's bones do not stretch, so anything above a few tenths of a millimetre cannot be
+# carried by a BVH.
+parents = {b.name: b.parent.name for b in arm.pose.bones if b.parent}
+spread, spread_bone = 0.0, ""
+for child, parent in parents.items():
+    c, p = names.index(child), names.index(parent)
+    lengths = [math.dist(f[c], f[p]) for f in ref["frames"]]
+    if max(lengths) - min(lengths) > spread:
+        spread, spread_bone = max(lengths) - min(lengths), child
+print(f"bone lengths: largest spread {spread*1000:.2f} mm ({spread_bone})")
 if worst > 1e-3:
     sys.exit(f"bone heads differ from our joints by {worst*1000:.2f} mm")

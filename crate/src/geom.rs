@@ -61,6 +61,12 @@ pub fn dist(a: Vec3, b: Vec3) -> f64 {
     norm(sub(a, b))
 }
 
+/// Smoothstep easing of `u` in 0–1 (clamped): starts and ends with zero speed.
+pub fn ease(u: f64) -> f64 {
+    let u = u.clamp(0.0, 1.0);
+    u * u * (3.0 - 2.0 * u)
+}
+
 /// A rotation as a unit quaternion `(w, x, y, z)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quat(pub [f64; 4]);
@@ -127,6 +133,25 @@ impl Quat {
         let v = cross(from, to);
         let w = (dot(from, from) * dot(to, to)).sqrt() + dot(from, to);
         Quat([w, v[0], v[1], v[2]]).normalized()
+    }
+
+    /// Spherical interpolation from `self` (t = 0) to `other` (t = 1) along the shorter arc.
+    pub fn slerp(self, other: Quat, t: f64) -> Quat {
+        let mut b = other.0;
+        let mut cos: f64 = self.0.iter().zip(&b).map(|(x, y)| x * y).sum();
+        // q and −q are the same rotation; the shorter arc avoids a needless full turn.
+        if cos < 0.0 {
+            b = b.map(|v| -v);
+            cos = -cos;
+        }
+        let (wa, wb) = if cos > 0.9995 {
+            (1.0 - t, t)
+        } else {
+            let theta = cos.min(1.0).acos();
+            let sin = theta.sin();
+            (((1.0 - t) * theta).sin() / sin, (t * theta).sin() / sin)
+        };
+        Quat(std::array::from_fn(|i| wa * self.0[i] + wb * b[i])).normalized()
     }
 
     /// The 3×3 rotation matrix, row-major: `m[row][col]`.

@@ -1,6 +1,7 @@
 //! What the planner hands to the generator: a prompt cut into consecutive segments, each with
 //! a whole-body motion, instructions per body part and an optional root path.
 
+use crate::posture::track::PostureTrack;
 use crate::skeleton::BodyPart;
 use crate::trajectory::Trajectory;
 use serde::{Deserialize, Serialize};
@@ -80,9 +81,21 @@ pub struct Segment {
     /// The path the root follows on the ground, if the segment asks for one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trajectory: Option<Trajectory>,
+    /// Key postures for what the motion model does not know: on all four parts they replace
+    /// the generated motion over the segment; on some parts they are held over it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub postures: Option<PostureTrack>,
 }
 
 /// Who made a plan.
+impl Segment {
+    /// Whether key poses make the whole segment (the generated motion under it is replaced, so
+    /// there is nothing of the model's to review).
+    pub fn is_posture_segment(&self) -> bool {
+        self.postures.as_ref().is_some_and(|t| t.whole_body())
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum PlannerKind {

@@ -377,6 +377,159 @@ pub fn uniform_skeleton(poses: &[Pose], target: &Offsets) -> Vec<Pose> {
     forward_kinematics(&rotations, target, &root)
 }
 
+/// The height (metres) of the lowest joint of a motion: its floor (`+∞` for no frames).
+pub fn lowest_joint(poses: &[Pose]) -> f64 {
+    poses
+        .iter()
+        .flat_map(|p| p.iter().map(|v| v[1]))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The joints that carry three bones, with the bones as the BVH export frames them: the
+/// parent, its left and right children (the frame's X axis runs from right to left) and the
+/// child above (its Y axis). Their three bones form a rigid triangle on any rigid skeleton.
+const BRANCHES: [(usize, [usize; 3]); 2] = [
+    (joint::PELVIS, [joint::L_HIP, joint::R_HIP, joint::SPINE1]),
+    (
+        joint::SPINE3,
+        [joint::L_COLLAR, joint::R_COLLAR, joint::NECK],
+    ),
+];
+
+/// Unit direction of every bone of a pose (child from parent); a bone of zero length points
+/// along its rest direction. Index 0 is unused.
+fn bone_directions(pose: &Pose) -> [Vec3; NUM_JOINTS] {
+    std::array::from_fn(|j| match PARENTS[j] {
+        None => [0.0; 3],
+        Some(parent) => {
+            let bone = geom::sub(pose[j], pose[parent]);
+            if geom::norm(bone) > 1e-9 {
+                geom::normalize(bone)
+            } else {
+                RAW_OFFSETS[j]
+            }
+        }
+    })
+}
+
+/// The frame of a branch's three bones in a pose (directions `dirs`, reference lengths):
+/// X from the right child to the left, Y towards the upper child. `None` when degenerate.
+fn branch_frame(dirs: &[Vec3; NUM_JOINTS], [left, right, up]: [usize; 3]) -> Option<Quat> {
+    let across = geom::sub(
+        geom::scale(dirs[left], REFERENCE_BONE_LENGTHS[left]),
+        geom::scale(dirs[right], REFERENCE_BONE_LENGTHS[right]),
+    );
+    let z = geom::cross(across, dirs[up]);
+    if geom::norm(across) < 1e-9 || geom::norm(z) < 1e-9 {
+        return None;
+    }
+    let x = geom::normalize(across);
+    let z = geom::normalize(z);
+    Some(Quat::from_columns(x, geom::cross(z, x), z))
+}
+
+/// What [`fixed_bones`] keeps of a motion as a whole: its floor, and the shape of the two
+/// triangles of bones at the pelvis (hips and spine) and at the upper spine (collars and
+/// neck), averaged over the frames. Fitted on one motion, it can be applied to the same
+/// frames with one more (the pose that features' last velocities lead to).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkeletonFit {
+    /// No frame is lowered below this height (metres): the motion's lowest joint.
+    pub floor: f64,
+    /// Per entry of [`BRANCHES`], the mean direction of its three bones in the branch's
+    /// frame (unit vectors).
+    branches: [[Vec3; 3]; 2],
+}
+
+impl SkeletonFit {
+    /// The fit of a motion.
+    pub fn of(poses: &[Pose]) -> SkeletonFit {
+        let mut branches = [[[0.0; 3]; 3]; 2];
+        for pose in poses {
+            let dirs = bone_directions(pose);
+            for (sums, (_, kids)) in branches.iter_mut().zip(BRANCHES) {
+                if let Some(frame) = branch_frame(&dirs, kids) {
+                    let inv = frame.inv();
+                    for (sum, kid) in sums.iter_mut().zip(kids) {
+                        *sum = geom::add(*sum, inv.rotate(dirs[kid]));
+                    }
+                }
+            }
+        }
+        SkeletonFit {
+            floor: lowest_joint(poses),
+            branches: branches.map(|sums| sums.map(geom::normalize)),
+        }
+    }
+
+    /// The poses on the reference skeleton with this fit's triangles, standing no lower
+    /// than its floor (see [`fixed_bones`]).
+    pub fn apply(&self, poses: &[Pose]) -> Vec<Pose> {
+        poses
+            .iter()
+            .map(|pose| {
+                let mut dirs = bone_directions(pose);
+                for (mean, (_, kids)) in self.branches.iter().zip(BRANCHES) {
+                    let usable = mean.iter().all(|d| geom::norm(*d) > 0.5);
+                    if let (true, Some(frame)) = (usable, branch_frame(&dirs, kids)) {
+                        for (d, kid) in mean.iter().zip(kids) {
+                            dirs[kid] = frame.rotate(*d);
+                        }
+                    }
+                }
+                let mut out = [pose[0]; NUM_JOINTS];
+                for chain in CHAINS {
+                    for pair in chain.windows(2) {
+                        let (parent, child) = (pair[0], pair[1]);
+                        let bone = geom::scale(dirs[child], REFERENCE_BONE_LENGTHS[child]);
+                        out[child] = geom::add(out[parent], bone);
+                    }
+                }
+                let lift = self.floor - lowest_joint(std::slice::from_ref(&out));
+                if lift > 0.0 && lift.is_finite() {
+                    for p in &mut out {
+                        p[1] += lift;
+                    }
+                }
+                out
+            })
+            .collect()
+    }
+}
+
+/// The motion on the one skeleton of the product: every bone gets its reference length
+/// ([`REFERENCE_BONE_LENGTHS`]), the pelvis keeps its position, and the joints are rebuilt
+/// outwards along the [`CHAINS`]. Bones keep their directions, but for the two groups of
+/// three that a skeleton holds rigid: the hips and the spine at the pelvis, and the collars
+/// and the neck at the upper spine, which take the motion's mean shape of their triangle,
+/// turned as the frame's own triangle is turned (X from the right hip or collar to the
+/// left, Y up the spine); a rigid skeleton such as the BVH export's could not carry them
+/// otherwise.
+/// Where the new lengths would take a frame below the motion's floor (its lowest joint
+/// before), that frame is lifted just enough to stand on it, so feet never sink.
+///
+/// Generated motions need it: the motion model predicts each joint's position on its own,
+/// so bones stretch and shrink (a wrist by several centimetres) and no rigid skeleton, the
+/// BVH export's included, could show them as they are. A motion already on the reference
+/// skeleton with rigid triangles (the dataset's) comes back unchanged.
+pub fn fixed_bones(poses: &[Pose]) -> Vec<Pose> {
+    SkeletonFit::of(poses).apply(poses)
+}
+
+/// The largest difference (metres) between a bone's length in `poses` and its reference
+/// length ([`REFERENCE_BONE_LENGTHS`]), over every bone and frame.
+pub fn max_bone_deviation(poses: &[Pose]) -> f64 {
+    poses
+        .iter()
+        .flat_map(|pose| {
+            (1..NUM_JOINTS).map(move |j| {
+                let parent = PARENTS[j].expect("non-root joint has a parent");
+                (geom::dist(pose[j], pose[parent]) - REFERENCE_BONE_LENGTHS[j]).abs()
+            })
+        })
+        .fold(0.0, f64::max)
+}
+
 /// The largest distance (metres) between corresponding joints of two motions, over the frames
 /// both have.
 pub fn max_joint_distance(a: &[Pose], b: &[Pose]) -> f64 {
@@ -438,6 +591,185 @@ mod tests {
                 assert!(geom::dist(*p, *q) < 1e-4, "joint {j}");
             }
         }
+    }
+
+    /// A motion on the reference skeleton whose hip and collar triangles are rigid and
+    /// shaped as a body's (hips below the pelvis, collars above the upper spine): the
+    /// triangle bones keep one rotation, the limbs swing, the root walks and turns.
+    fn skeleton_motion(frames: usize) -> Vec<Pose> {
+        let rots: Vec<Rotations> = (0..frames)
+            .map(|t| {
+                let s = (t as f64 * 0.3).sin();
+                let mut r = [Quat::IDENTITY; NUM_JOINTS];
+                r[0] = Quat::from_yaw(0.03 * t as f64);
+                r[joint::L_HIP] = Quat::from_axis_angle([0.0, 0.0, 1.0], -0.33);
+                r[joint::R_HIP] = Quat::from_axis_angle([0.0, 0.0, 1.0], 0.31);
+                r[joint::L_KNEE] = Quat::from_axis_angle([1.0, 0.0, 0.0], 0.33)
+                    .mul(Quat::from_axis_angle([1.0, 0.0, 0.0], -0.5 * s));
+                r[joint::R_KNEE] = Quat::from_axis_angle([1.0, 0.0, 0.0], 0.5 * s);
+                r[joint::L_ANKLE] = Quat::from_axis_angle([1.0, 0.0, 0.0], 0.4 * s.abs());
+                r[joint::L_COLLAR] = Quat::from_axis_angle([0.0, 0.0, 1.0], 0.31);
+                r[joint::R_COLLAR] = Quat::from_axis_angle([0.0, 0.0, 1.0], -0.42);
+                r[joint::NECK] = Quat::from_axis_angle([0.0, 0.0, 1.0], 0.06);
+                r[joint::L_SHOULDER] = Quat::from_axis_angle([1.0, 0.0, 0.0], 0.8 * s);
+                r[joint::R_ELBOW] = Quat::from_axis_angle([0.2, 0.0, 1.0], 1.0 + s);
+                r[joint::L_WRIST] = Quat::from_axis_angle([1.0, 0.0, 0.0], -0.7);
+                r
+            })
+            .collect();
+        let root: Vec<Vec3> = (0..frames).map(|t| [0.1, 0.95, 0.04 * t as f64]).collect();
+        forward_kinematics(&rots, &Offsets::reference(), &root)
+    }
+
+    /// The same motion as a motion model might predict it: every bone stretched or shrunk
+    /// by up to 25 %, differently in every frame, and (with `wobble`) the hip and collar
+    /// bones turned by a few degrees, differently in every frame.
+    fn predicted(poses: &[Pose], wobble: f64) -> Vec<Pose> {
+        let mut rng = crate::rng::Rng::new(17);
+        poses
+            .iter()
+            .map(|pose| {
+                let mut out = [pose[0]; NUM_JOINTS];
+                for chain in CHAINS {
+                    for pair in chain.windows(2) {
+                        let (p, c) = (pair[0], pair[1]);
+                        let mut bone = geom::sub(pose[c], pose[p]);
+                        if matches!(c, 1 | 2 | 3 | 12 | 13 | 14) {
+                            let axis = [rng.normal(), rng.normal(), rng.normal()].map(f64::from);
+                            let angle = wobble * f64::from(rng.normal());
+                            bone = Quat::from_axis_angle(axis, angle).rotate(bone);
+                        }
+                        let stretch = 1.0 + 0.25 * (2.0 * f64::from(rng.uniform()) - 1.0);
+                        out[c] = geom::add(out[p], geom::scale(bone, stretch));
+                    }
+                }
+                out
+            })
+            .collect()
+    }
+
+    fn angle(a: Vec3, b: Vec3) -> f64 {
+        geom::dot(geom::normalize(a), geom::normalize(b))
+            .clamp(-1.0, 1.0)
+            .acos()
+    }
+
+    #[test]
+    fn fixed_bones_keeps_a_motion_on_the_skeleton() {
+        let motion = skeleton_motion(60);
+        assert!(max_bone_deviation(&motion) < 1e-12);
+        let fixed = fixed_bones(&motion);
+        assert!(max_joint_distance(&motion, &fixed) < 1e-9);
+    }
+
+    #[test]
+    fn fixed_bones_gives_reference_lengths_and_keeps_directions() {
+        let truth = skeleton_motion(60);
+        let stretched = predicted(&truth, 0.0);
+        assert!(max_bone_deviation(&stretched) > 0.05);
+        let fixed = fixed_bones(&stretched);
+        assert!(max_bone_deviation(&fixed) < 1e-9);
+        for (before, after) in stretched.iter().zip(&fixed) {
+            // The pelvis stays where it was on the ground plane and is only ever lifted.
+            assert!(
+                geom::dist(
+                    [before[0][0], before[0][2], 0.0],
+                    [after[0][0], after[0][2], 0.0]
+                ) < 1e-12
+            );
+            assert!(after[0][1] >= before[0][1] - 1e-12);
+            for j in 1..NUM_JOINTS {
+                let p = PARENTS[j].unwrap();
+                let turned = angle(
+                    geom::sub(before[j], before[p]),
+                    geom::sub(after[j], after[p]),
+                );
+                assert!(turned < 1e-6, "bone {j} turned by {turned} rad");
+            }
+        }
+        // Only stretched bones were in the way: the fix gives back the true motion, up to
+        // the lift that keeps the longer legs above the floor.
+        let lifted = |poses: &[Pose]| {
+            poses
+                .iter()
+                .map(|p| p.map(|v| [v[0], 0.0, v[2]]))
+                .collect::<Vec<_>>()
+        };
+        assert!(max_joint_distance(&lifted(&truth), &lifted(&fixed)) < 1e-9);
+    }
+
+    #[test]
+    fn fixed_bones_makes_the_hip_and_collar_triangles_rigid() {
+        let wobbly = predicted(&skeleton_motion(60), 0.05);
+        let fixed = fixed_bones(&wobbly);
+        assert!(max_bone_deviation(&fixed) < 1e-9);
+        for (parent, [l, r, u]) in BRANCHES {
+            let sides = |p: &Pose| {
+                [
+                    geom::dist(p[l], p[r]),
+                    geom::dist(p[l], p[u]),
+                    geom::dist(p[r], p[u]),
+                    geom::dist(p[parent], p[u]),
+                ]
+            };
+            let first = sides(&fixed[0]);
+            for pose in &fixed {
+                for (a, b) in sides(pose).iter().zip(first) {
+                    assert!((a - b).abs() < 1e-9, "triangle at {parent}: {a} vs {b}");
+                }
+            }
+        }
+        // So the BVH export, whose skeleton is rigid, carries the motion exactly.
+        let bvh = crate::bvh::writer::write_bvh(&fixed, 20.0).unwrap();
+        let back = crate::bvh::to_smpl_motion(&crate::bvh::Bvh::parse(&bvh).unwrap()).unwrap();
+        assert!(max_joint_distance(&fixed, &back) < 1e-4);
+        let wobbly_back = crate::bvh::to_smpl_motion(
+            &crate::bvh::Bvh::parse(&crate::bvh::writer::write_bvh(&wobbly, 20.0).unwrap())
+                .unwrap(),
+        )
+        .unwrap();
+        assert!(max_joint_distance(&wobbly, &wobbly_back) > 0.01);
+    }
+
+    #[test]
+    fn fixed_bones_does_not_sink_feet() {
+        // Shins 10 cm short, standing on the floor at y = 0.
+        let mut motion = skeleton_motion(30);
+        for pose in &mut motion {
+            for j in [joint::L_ANKLE, joint::L_FOOT, joint::R_ANKLE, joint::R_FOOT] {
+                let k = if j == joint::L_ANKLE || j == joint::L_FOOT {
+                    joint::L_KNEE
+                } else {
+                    joint::R_KNEE
+                };
+                let a = if j == joint::L_ANKLE || j == joint::L_FOOT {
+                    joint::L_ANKLE
+                } else {
+                    joint::R_ANKLE
+                };
+                let shorten = geom::scale(geom::normalize(geom::sub(pose[a], pose[k])), -0.1);
+                pose[j] = geom::add(pose[j], shorten);
+            }
+        }
+        let floor = lowest_joint(&motion);
+        for pose in &mut motion {
+            for p in pose.iter_mut() {
+                p[1] -= floor;
+            }
+        }
+        let fixed = fixed_bones(&motion);
+        assert!(max_bone_deviation(&fixed) < 1e-9);
+        for (before, after) in motion.iter().zip(&fixed) {
+            let low = lowest_joint(std::slice::from_ref(after));
+            assert!(low > -1e-9, "a joint sank to {low} m");
+            // Lifted by the 10 cm the legs grew, no more.
+            let lift = after[0][1] - before[0][1];
+            assert!((-1e-12..0.1 + 1e-9).contains(&lift), "lifted by {lift} m");
+        }
+        assert!(
+            lowest_joint(&fixed).abs() < 1e-9,
+            "the lowest frame stands on the floor"
+        );
     }
 
     #[test]

@@ -198,7 +198,13 @@ pub async fn run<T: Transport>(
         let score_before = scorer.map(|s| s.segment_score(segment, &normalized));
         let mut current = score_before;
         let mut rounds = Vec::new();
-        for round in 0..options.rounds {
+        // Key poses replace a posture segment's generated motion: nothing to review there.
+        let review_rounds = if segment.is_posture_segment() {
+            0
+        } else {
+            options.rounds
+        };
+        for round in 0..review_rounds {
             let poses = features_to_joints(&model.normalizer.denormalize(&normalized));
             let mut review = match scorer {
                 Some(s) => reviewer::judge_offline(segment, &poses, &normalized, s),
@@ -358,6 +364,39 @@ pub fn segment_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range
         .collect()
 }
 
+/// The plan's posture tracks laid over a motion's features (not normalised, 20 fps, after its
+/// paths): posture segments replace the generated frames with their key poses, held postures
+/// take over their body parts (see [`crate::posture::track::lay_tracks`]). The features are
+/// computed again from the new joints, on the reference skeleton. The notes say which key
+/// poses could not be met in full.
+pub fn lay_postures(
+    plan: &Plan,
+    tokens: &MotionTokens,
+    features: &[FeatureFrame],
+) -> (Features, Vec<String>) {
+    use crate::posture::track::{lay_tracks, TrackSpan};
+    let spans: Vec<TrackSpan> = plan
+        .segments
+        .iter()
+        .zip(segment_ranges(plan, tokens))
+        .filter_map(|(s, frames)| s.postures.as_ref().map(|track| TrackSpan { frames, track }))
+        .collect();
+    if spans.is_empty() || features.is_empty() {
+        return (features.to_vec(), Vec::new());
+    }
+    let joints = crate::features::features_to_joints_with_final(features);
+    let (laid, notes) = lay_tracks(&joints, &spans);
+    match crate::features::joints_to_features(&laid, &crate::skeleton::Offsets::reference()) {
+        Ok((laid, _)) => (laid, notes),
+        Err(e) => (
+            features.to_vec(),
+            vec![format!(
+                "the key postures could not be laid on the motion: {e}"
+            )],
+        ),
+    }
+}
+
 /// The features (not normalised, 20 fps) of a run's tokens with every segment's path laid on
 /// the root. A link rebuilds the motion with this and its plan alone.
 pub async fn motion_features(
@@ -506,6 +545,7 @@ mod tests {
             base: "a person walks forward".into(),
             parts,
             trajectory: None,
+            postures: None,
         }
     }
 

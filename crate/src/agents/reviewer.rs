@@ -350,6 +350,7 @@ mod tests {
                 ..Default::default()
             },
             trajectory: None,
+            postures: None,
         }
     }
 

@@ -152,6 +152,7 @@ fn reviewed(
         base: caption.to_string(),
         parts: PartEdits::default(),
         trajectory: None,
+        postures: None,
     };
     let plan = Plan {
         prompt: caption.to_string(),

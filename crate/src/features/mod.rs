@@ -246,6 +246,46 @@ pub fn features_to_joints_with_final(features: &[FeatureFrame]) -> Vec<Pose> {
     poses
 }
 
+/// The same motion on the reference skeleton: the features of
+/// [`skeleton::fixed_bones`] of the joints they describe, so that
+/// [`features_to_joints`] of the result gives every bone its reference length (to f32
+/// precision) while the root path, the facing and every bone's direction stay. Rewritten
+/// columns: the root height (where a frame is lifted off the floor), the root-relative
+/// positions and the joint velocities (differences of the new joints; the last row's leads
+/// to the new last pose's successor). The 6D rotations and the foot contacts are kept: they
+/// depend only on bone directions and on motion that the new lengths do not change.
+pub fn with_reference_bones(features: &[FeatureFrame]) -> Features {
+    if features.is_empty() {
+        return Vec::new();
+    }
+    // Fitted on the frames shown, not on the extra pose the last velocities lead to, so the
+    // shown joints are exactly `fixed_bones` of the joints shown before.
+    let fit = skeleton::SkeletonFit::of(&features_to_joints(features));
+    let poses = fit.apply(&features_to_joints_with_final(features));
+    let (rots, _) = recover_root(features);
+    features
+        .iter()
+        .enumerate()
+        .map(|(t, row)| {
+            let mut out = *row;
+            let (pose, next, facing) = (&poses[t], &poses[t + 1], rots[t]);
+            let root = pose[0];
+            out[ROOT_HEIGHT.start] = root[1] as f32;
+            for (j, p) in pose.iter().enumerate().skip(1) {
+                let local = [p[0] - root[0], p[1], p[2] - root[2]];
+                let c = POSITIONS.start + (j - 1) * 3;
+                out[c..c + 3].copy_from_slice(&facing.rotate(local).map(|v| v as f32));
+            }
+            for (j, (now, then)) in pose.iter().zip(next).enumerate() {
+                let v = facing.rotate(geom::sub(*then, *now));
+                let c = VELOCITIES.start + j * 3;
+                out[c..c + 3].copy_from_slice(&v.map(|v| v as f32));
+            }
+            out
+        })
+        .collect()
+}
+
 /// Mirrors features left/right: the result describes exactly the mirrored joints (X negated,
 /// left and right swapped) on the same body. Applying it twice is the identity. (Computing
 /// features from mirrored joints gives slightly different numbers, because the reference
@@ -492,6 +532,36 @@ mod tests {
             .collect();
         let root: Vec<Vec3> = (0..frames).map(|t| [0.3, 0.9, 0.05 * t as f64]).collect();
         skeleton::forward_kinematics(&rots, &offsets, &root)
+    }
+
+    #[test]
+    fn with_reference_bones_describes_the_fixed_joints() {
+        let (mut feats, _) = joints_to_features(&synthetic(40), &Offsets::reference()).unwrap();
+        // Bones stretched as a motion model's predictions stretch them.
+        for (t, row) in feats.iter_mut().enumerate() {
+            for (c, v) in row[POSITIONS].iter_mut().enumerate() {
+                *v += 0.03 * ((t * 7 + c * 13) as f32 * 0.37).sin();
+            }
+        }
+        let stretched = features_to_joints(&feats);
+        assert!(skeleton::max_bone_deviation(&stretched) > 0.02);
+        let fixed = with_reference_bones(&feats);
+        assert_eq!(fixed.len(), feats.len());
+        let joints = features_to_joints(&fixed);
+        assert!(skeleton::max_bone_deviation(&joints) < 1e-5);
+        assert!(skeleton::max_joint_distance(&joints, &skeleton::fixed_bones(&stretched)) < 1e-5);
+        // The last velocities lead to a pose on the same skeleton, and the root keeps its
+        // path and facing.
+        let with_final = features_to_joints_with_final(&fixed);
+        assert!(skeleton::max_bone_deviation(&with_final[with_final.len() - 1..]) < 1e-5);
+        let ((rots_a, root_a), (rots_b, root_b)) = (recover_root(&feats), recover_root(&fixed));
+        assert_eq!(rots_a, rots_b);
+        for (a, b) in root_a.iter().zip(&root_b) {
+            assert_eq!([a[0], a[2]], [b[0], b[2]]);
+        }
+        // Fixing twice changes nothing more.
+        let again = features_to_joints(&with_reference_bones(&fixed));
+        assert!(skeleton::max_joint_distance(&joints, &again) < 1e-5);
     }
 
     #[test]

@@ -9,9 +9,12 @@
 //! - Shapes: the local bone rotations of the two keys (inverse kinematics, no twist) are
 //!   slerped with a smoothstep ease and rebuilt by forward kinematics on the reference skeleton,
 //!   so every frame has its bone lengths, whatever skeleton the keys were solved on.
-//! - Placement: the facing angle is interpolated as an angle (a 360° turn is a full spin), the
-//!   ground position along a straight line, the pelvis height so that the joints that carry
-//!   weight in both keys stay on the floor.
+//! - Placement: each key is set where the joints it shares on the ground with the previous key
+//!   (its supports) stay where they were, moved by the key's travel and turned about the old
+//!   pelvis by its turn; a squat solved with its pelvis above the origin thus sits back over
+//!   the standing feet instead of stepping forward. The facing angle is interpolated as an
+//!   angle (a 360° turn is a full spin), the ground position along a straight line, the pelvis
+//!   height so that the supports stay on the floor.
 //! - Contacts: a foot (ankle, toe) or hand (wrist) within [`CONTACT_HEIGHT`] of the floor in a
 //!   key is on the ground there. A limb on the ground in both keys at the same place stays
 //!   planted; one that must move (the body travels or turns under it) steps: it stays put,
@@ -33,9 +36,8 @@ use crate::skeleton::{
 use crate::timing::FPS;
 
 /// The fastest a joint may move outside flight (m/s, frame to frame). Transitions that would
-/// move a joint faster are lengthened. Real motion capture at a brisk pace keeps hands and feet
-/// under about this speed most of the time; the dataset's own 99th percentile is measured by
-/// the evaluation.
+/// move a joint faster are lengthened. A chosen bound, not a measurement: the training data's
+/// 99th-percentile joint speed is measured by the evaluation, and this should follow it.
 pub const MAX_JOINT_SPEED: f64 = 3.5;
 
 /// Gravitational acceleration for flights (m/s²).
@@ -94,6 +96,9 @@ const MAX_COORDINATE: f64 = 100.0;
 /// How strongly a straight limb prefers its hint direction when it must bend: as much as a
 /// bend of this many metres.
 const HINT_WEIGHT: f64 = 0.01;
+/// Width (metres) of the band below full reach in which a lifted limb approaches its reach
+/// softly (see `two_bone`).
+const SOFT_REACH: f64 = 0.03;
 /// Headroom on the measured peak speed: samples can straddle the true peak.
 const SPEED_MARGIN: f64 = 1.05;
 
@@ -118,15 +123,17 @@ pub enum Transition {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KeyPose {
     /// The body shape: world joint positions (metres, Y up) solved at the origin facing +Z,
-    /// lowest joint on the floor. Only bone directions, the pelvis's ground offset and the
-    /// contacts are read from it; bone lengths come from the reference skeleton, and the body is
-    /// set on the floor again. A pose with a coordinate that is not finite or beyond 100 m is
-    /// replaced by the rest pose (standing, arms down).
+    /// lowest joint on the floor. Bone directions, contacts (joints within [`CONTACT_HEIGHT`]
+    /// of the floor) and, for a key with no support in common with the previous one, the
+    /// pelvis's ground offset are read from it; bone lengths come from the reference skeleton,
+    /// and the body is set on the floor again. A pose with a coordinate that is not finite or
+    /// beyond 100 m is replaced by the rest pose (standing, arms down).
     pub pose: Pose,
     /// Seconds to move from the previous key into this one (ignored for the first key). Not a
     /// number or negative counts as 0; raised to [`MIN_TRANSITION`] ([`MIN_PUSH_OFF`] before
     /// a flight), capped at [`MAX_KEY_SECONDS`], and lengthened when the movement would
-    /// otherwise be faster than [`MAX_JOINT_SPEED`]. For a flight it is the push-off time only.
+    /// otherwise be faster than [`MAX_JOINT_SPEED`] (to at most [`MAX_KEY_SECONDS`]). For a
+    /// flight it is the push-off time only.
     pub transition: f64,
     /// Seconds the pose is held once reached (0 to [`MAX_KEY_SECONDS`]; not a number is 0).
     pub hold: f64,
@@ -135,7 +142,9 @@ pub struct KeyPose {
     /// 360 or 720 make full spins. Ignored for the first key; capped at ±3600°.
     pub turn_deg: f64,
     /// Ground displacement of the body `[left, forward]` (metres) in the previous key's facing
-    /// frame, covered during the transition. Ignored for the first key.
+    /// frame, covered during the transition: the supports of this key are expected that far
+    /// from the previous key's (limbs on the ground step there), and with the same shape the
+    /// pelvis moves exactly that far. Ignored for the first key; capped at ±50 m.
     pub travel: [f64; 2],
     /// How this key is reached.
     pub motion: Transition,
@@ -158,8 +167,9 @@ impl KeyPose {
 
 /// Turns key poses into a motion: world joint positions at 20 fps, starting at the first key
 /// (at the origin, facing +Z) and ending at the end of the last key's hold, at most
-/// [`MAX_SECONDS`] long. An empty list gives an empty motion; the same keys always give the
-/// same frames.
+/// [`MAX_SECONDS`] long. A transition too short for its movement is lengthened (never skipped
+/// or jumped), so the motion may be longer than the keys' times add up to. An empty list
+/// gives an empty motion; the same keys always give the same frames.
 pub fn go(keys: &[KeyPose]) -> Vec<Pose> {
     if keys.is_empty() {
         return Vec::new();
@@ -175,7 +185,8 @@ pub fn go(keys: &[KeyPose]) -> Vec<Pose> {
 /// `keys[0]` once more, so that squats or jumping jacks end standing. Between cycles the first
 /// key is reached from the last one with the first key's own `transition`, `turn_deg`,
 /// `travel` and `motion` (which [`go`] ignores for the very first key), so a cycle that travels
-/// puts its last stride there. At most [`MAX_REPEAT_KEYS`] keys (at least one cycle).
+/// puts its last stride there. At most [`MAX_REPEAT_KEYS`] keys, unless one cycle alone has
+/// more (it is then returned once, closed).
 pub fn repeat(keys: &[KeyPose], times: usize) -> Vec<KeyPose> {
     if keys.is_empty() || times == 0 {
         return Vec::new();
@@ -257,6 +268,9 @@ const LIMBS: [Limb; 4] = [
 struct Target {
     end: Vec3,
     tip: Option<Vec3>,
+    /// 0–1: how much the limb may fall short of a target near its full reach (see
+    /// [`SOFT_REACH`]); 0 for a limb that carries weight.
+    soft: f64,
 }
 
 #[derive(Clone, Copy)]
@@ -286,6 +300,8 @@ struct Key {
     /// Facing (radians about +Y from +Z) and ground origin of the key's frame.
     yaw: f64,
     ground: Vec3,
+    /// Ground origin at take-off, for a key reached by a flight.
+    takeoff: Vec3,
     /// Facing change from the previous key (radians).
     turn: f64,
     /// Eased transition, or push-off for a flight (seconds).
@@ -423,9 +439,9 @@ fn pose_of(rots: &Rotations, yaw: f64, root: Vec3, offsets: &Offsets) -> Pose {
     forward_kinematics(&[rots], offsets, &[root])[0]
 }
 
-/// A key pose's bone rotations, pelvis (ground offset and height over the floor) and its
-/// joints' heights over the floor.
-fn shape(pose: &Pose, offsets: &Offsets) -> (Rotations, Vec3, [f64; NUM_JOINTS]) {
+/// A key pose's bone rotations, pelvis (ground offset x, height over the floor, ground offset
+/// z) and joints in its own frame (facing +Z, lowest joint on the floor).
+fn shape(pose: &Pose, offsets: &Offsets) -> (Rotations, Vec3, Pose) {
     let usable = pose
         .iter()
         .flatten()
@@ -442,9 +458,67 @@ fn shape(pose: &Pose, offsets: &Offsets) -> (Rotations, Vec3, [f64; NUM_JOINTS])
     };
     rots[0] = Quat::IDENTITY;
     let body = pose_of(&rots, 0.0, [0.0; 3], offsets);
-    let low = lowest(&body);
-    let heights = std::array::from_fn(|j| body[j][1] - low);
-    (rots, [pelvis_xz[0], -low, pelvis_xz[1]], heights)
+    let pelvis = [pelvis_xz[0], -lowest(&body), pelvis_xz[1]];
+    (rots, pelvis, body.map(|p| geom::add(p, pelvis)))
+}
+
+/// Where the body must stand so that its supports do not move needlessly: the ground offset
+/// (metres, x and z) to add to `prev.ground + travel` for a key of shape `local` facing `yaw`.
+///
+/// Key poses are solved independently, each with its pelvis above the origin, so a squat's
+/// feet sit ahead of a stand's. The supports of the new key (joints on the ground in both keys)
+/// are expected where the old ones were, turned about the old pelvis and moved by `travel`; the
+/// offset is the one that meets that expectation for the most limbs (all supports together
+/// first, then each limb's own), ties going to the smaller total miss.
+fn align(prev: &Key, local: &Pose, contact: &[bool; NUM_JOINTS], yaw: f64, travel: Vec3) -> Vec3 {
+    let pelvis = prev.world[joint::PELVIS];
+    let turn = yaw - prev.yaw;
+    let flat = |v: Vec3| [v[0], 0.0, v[2]];
+    let misses: Vec<Vec<Vec3>> = LIMBS
+        .iter()
+        .map(|limb| {
+            limb.effectors()
+                .filter(|&e| prev.contact[e] && contact[e])
+                .map(|e| {
+                    let expected = geom::add(
+                        geom::add(pelvis, yawed(turn, geom::sub(prev.world[e], pelvis))),
+                        travel,
+                    );
+                    let placed =
+                        geom::add(geom::add(prev.ground, travel), yawed(yaw, flat(local[e])));
+                    flat(geom::sub(expected, placed))
+                })
+                .collect()
+        })
+        .collect();
+    let mean = |v: &[Vec3]| {
+        let sum = v.iter().fold([0.0; 3], |a, b| geom::add(a, *b));
+        geom::scale(sum, 1.0 / v.len().max(1) as f64)
+    };
+    let all: Vec<Vec3> = misses.iter().flatten().copied().collect();
+    if all.is_empty() {
+        return [0.0; 3];
+    }
+    let score = |offset: Vec3| {
+        let kept = misses
+            .iter()
+            .filter(|m| {
+                !m.is_empty() && m.iter().all(|d| geom::dist(*d, offset) <= PLANT_TOLERANCE)
+            })
+            .count();
+        let miss: f64 = all.iter().map(|d| geom::dist(*d, offset)).sum();
+        (kept, miss)
+    };
+    let mut best = mean(&all);
+    let mut best_score = score(best);
+    for m in misses.iter().filter(|m| !m.is_empty()) {
+        let offset = mean(m);
+        let s = score(offset);
+        if s.0 > best_score.0 || (s.0 == best_score.0 && s.1 < best_score.1 - 1e-9) {
+            (best, best_score) = (offset, s);
+        }
+    }
+    best
 }
 
 /// Two-bone IK: the middle and end joints that put the end on `target` (or as near as the bones
@@ -456,6 +530,7 @@ fn two_bone(
     target: Vec3,
     [l1, l2]: [f64; 2],
     hint: Vec3,
+    soft: f64,
 ) -> (Vec3, Vec3) {
     let to = geom::sub(target, root);
     let length = geom::norm(to);
@@ -469,6 +544,18 @@ fn two_bone(
             [0.0, -1.0, 0.0]
         }
     };
+    // Near full reach the middle joint's offset grows like √(reach − distance): a limb that
+    // straightens or starts to bend there at any speed swings its knee or elbow infinitely
+    // fast. A lifted limb may instead approach its reach exponentially (and fall short of the
+    // target by at most SOFT_REACH / e), faded in and out with its lift so that a limb that
+    // carries weight reaches its target exactly.
+    let zone = l1 + l2 - SOFT_REACH;
+    let softened = if length > zone {
+        zone + SOFT_REACH * (1.0 - (-(length - zone) / SOFT_REACH).exp())
+    } else {
+        length
+    };
+    let length = length - soft.clamp(0.0, 1.0) * (length - softened);
     let d = length.clamp((l1 - l2).abs() + 1e-9, l1 + l2);
     let along = (l1 * l1 - l2 * l2 + d * d) / (2.0 * d);
     let out = (l1 * l1 - along * along).max(0.0).sqrt();
@@ -500,15 +587,22 @@ fn pinned(limb: &Limb, end: Option<Vec3>, tip: Option<Vec3>, pose: &Pose) -> Opt
         (Some(end), _, Some(tip)) => Some(Target {
             end,
             tip: Some(tip),
+            soft: 0.0,
         }),
         (Some(end), Some(t), None) => Some(Target {
             end,
             tip: Some(geom::add(end, geom::sub(pose[t], pose[limb.end]))),
+            soft: 0.0,
         }),
-        (Some(end), None, None) => Some(Target { end, tip: None }),
+        (Some(end), None, None) => Some(Target {
+            end,
+            tip: None,
+            soft: 0.0,
+        }),
         (None, Some(t), Some(tip)) => Some(Target {
             end: geom::add(tip, geom::sub(pose[limb.end], pose[t])),
             tip: Some(tip),
+            soft: 0.0,
         }),
         _ => None,
     }
@@ -548,6 +642,7 @@ fn solve(pose: &mut Pose, targets: &[Option<Target>; 4], yaw: f64) {
             target.end,
             [bone(limb.mid), bone(limb.end)],
             hint,
+            target.soft,
         );
         if let Some(tip) = limb.tip {
             let natural = geom::sub(pose[tip], pose[limb.end]);
@@ -581,9 +676,10 @@ impl Timeline {
             if i > 0 && clock >= MAX_SECONDS {
                 break;
             }
-            let (rots, pelvis, heights) = shape(&key.pose, &timeline.offsets);
-            let (yaw, ground, turn, flight) = match timeline.keys.last() {
-                None => (0.0, [0.0; 3], 0.0, None),
+            let (rots, pelvis, local) = shape(&key.pose, &timeline.offsets);
+            let contact = local.map(|p| p[1] < CONTACT_HEIGHT);
+            let (yaw, ground, takeoff, turn, flight) = match timeline.keys.last() {
+                None => (0.0, [0.0; 3], [0.0; 3], 0.0, None),
                 Some(prev) => {
                     let turn = finite_or_zero(key.turn_deg)
                         .clamp(-MAX_TURN_DEG, MAX_TURN_DEG)
@@ -591,8 +687,19 @@ impl Timeline {
                     let [left, forward] = key
                         .travel
                         .map(|v| finite_or_zero(v).clamp(-MAX_TRAVEL, MAX_TRAVEL));
-                    let ground = geom::add(prev.ground, yawed(prev.yaw, [left, 0.0, forward]));
-                    (prev.yaw + turn, ground, turn, flight_of(key.motion))
+                    let travel = yawed(prev.yaw, [left, 0.0, forward]);
+                    let yaw = prev.yaw + turn;
+                    let ground = geom::add(
+                        geom::add(prev.ground, travel),
+                        align(prev, &local, &contact, yaw, travel),
+                    );
+                    // A jump takes off in its new shape from where it stands, still facing the
+                    // old way; turn and travel happen in the air.
+                    let takeoff = geom::add(
+                        prev.ground,
+                        align(prev, &local, &contact, prev.yaw, [0.0; 3]),
+                    );
+                    (yaw, ground, takeoff, turn, flight_of(key.motion))
                 }
             };
             let root = root_position(ground, yaw, pelvis, pelvis[1]);
@@ -600,9 +707,10 @@ impl Timeline {
                 world: pose_of(&rots, yaw, root, &timeline.offsets),
                 rots,
                 pelvis,
-                contact: heights.map(|h| h < CONTACT_HEIGHT),
+                contact,
                 yaw,
                 ground,
+                takeoff,
                 turn,
                 trans: 0.0,
                 hold: seconds(key.hold),
@@ -766,16 +874,14 @@ impl Timeline {
 
     /// Target of a moving limb at `u` of the transition into `b`: pinned between its windows;
     /// inside one, lifted first, moved across while high, set down last.
-    fn moving_target(&self, b: usize, limb: &Limb, u: f64, mode: LimbMode) -> Target {
-        let LimbMode::Moving {
-            slot,
-            of,
-            steps,
-            stepping,
-        } = mode
-        else {
-            unreachable!("only moving limbs have moving targets")
-        };
+    fn moving_target(
+        &self,
+        b: usize,
+        limb: &Limb,
+        u: f64,
+        [slot, of, steps]: [usize; 3],
+        stepping: bool,
+    ) -> Target {
         let windows = (of * steps) as f64;
         let mut from = 0.0;
         let mut active = None;
@@ -792,13 +898,13 @@ impl Timeline {
             }
             from = to;
         }
-        let place = |p: &Pose, j: usize| p[j];
         match active {
             None => {
                 let p = self.natural(b, from);
                 Target {
-                    end: place(&p, limb.end),
-                    tip: limb.tip.map(|t| place(&p, t)),
+                    end: p[limb.end],
+                    tip: limb.tip.map(|t| p[t]),
+                    soft: 0.0,
                 }
             }
             Some((r, to)) => {
@@ -818,6 +924,7 @@ impl Timeline {
                 Target {
                     end: at(limb.end),
                     tip: limb.tip.map(at),
+                    soft: bump(r),
                 }
             }
         }
@@ -831,7 +938,8 @@ impl Timeline {
         let mut targets = [None; 4];
         let (yaw, mut pose) = match kb.flight {
             Some(f) => {
-                let natural = self.body(b, s, ka.yaw, ka.ground, 0.0);
+                let ground = geom::lerp(ka.ground, kb.takeoff, s);
+                let natural = self.body(b, s, ka.yaw, ground, 0.0);
                 // u³ − u² is 0 at both ends and climbs at 1/push-off at take-off: the pelvis
                 // leaves at the flight's speed after dipping below the shape's path.
                 let spring = if launch {
@@ -867,9 +975,12 @@ impl Timeline {
                             };
                             pinned(limb, pin(limb.end), limb.tip.and_then(pin), &pose)
                         }
-                        mode @ LimbMode::Moving { .. } => {
-                            Some(self.moving_target(b, limb, u, mode))
-                        }
+                        LimbMode::Moving {
+                            slot,
+                            of,
+                            steps,
+                            stepping,
+                        } => Some(self.moving_target(b, limb, u, [slot, of, steps], stepping)),
                         _ => None,
                     };
                 }
@@ -885,7 +996,7 @@ impl Timeline {
         let (ka, kb) = (&self.keys[b - 1], &self.keys[b]);
         let q = (t / flight.time).clamp(0.0, 1.0);
         let yaw = ka.yaw + q * kb.turn;
-        let ground = geom::lerp(ka.ground, kb.ground, q);
+        let ground = geom::lerp(kb.takeoff, kb.ground, q);
         let height = kb.pelvis[1] + dip + flight.v0 * t - 0.5 * GRAVITY * t * t;
         let mut pose = pose_of(
             &kb.rots,
@@ -1015,7 +1126,8 @@ mod tests {
     }
 
     /// Thighs raised `hip` degrees forward, knees bent `knee` degrees, feet flat, torso leaning
-    /// forward; moved so the feet stand where the standing pose's do.
+    /// forward; pelvis above the origin as the posture solver leaves it, so the feet are ahead
+    /// of where they are standing.
     fn bent(hip: f64, knee: f64, lean: f64) -> Pose {
         let mut rots = [Quat::IDENTITY; NUM_JOINTS];
         for (thigh, shin, foot) in [
@@ -1027,13 +1139,7 @@ mod tests {
             rots[foot] = rot_x(hip - knee);
         }
         rots[joint::SPINE1] = rot_x(lean);
-        let mut pose = pose_from(rots);
-        let stand = standing();
-        let dz = stand[joint::L_ANKLE][2] - pose[joint::L_ANKLE][2];
-        for p in pose.iter_mut() {
-            p[2] += dz;
-        }
-        pose
+        pose_from(rots)
     }
 
     fn squat() -> Pose {
@@ -1299,6 +1405,25 @@ mod tests {
         assert!((end[joint::PELVIS][1] - stand).abs() < 1e-3);
         assert!(lowest(end).abs() < 1e-9);
         assert!(dist_xz(end[joint::L_ANKLE], motion[0][joint::L_ANKLE]) < 1e-6);
+
+        // A half-turn jump forward turns and travels in the air and lands facing back.
+        let motion = go(&[
+            KeyPose::new(standing(), 0.0, 0.2),
+            KeyPose::new(crouch(), 0.6, 0.1),
+            KeyPose {
+                motion: Transition::Flight { apex_m: 0.3 },
+                turn_deg: 180.0,
+                travel: [0.0, 0.5],
+                ..KeyPose::new(standing(), 0.3, 0.5)
+            },
+        ]);
+        let end = motion.last().unwrap();
+        assert!(facing(end).cos() < -0.9999, "faces {}", facing(end));
+        let moved = end[joint::PELVIS][2] - motion[0][joint::PELVIS][2];
+        assert!((moved - 0.5).abs() < 0.15, "moved {moved}");
+        let airborne: Vec<&Pose> = motion.iter().filter(|p| lowest(p) > 0.01).collect();
+        let turned = |p: &Pose| facing(p).cos();
+        assert!(turned(airborne[0]) > 0.9 && turned(airborne[airborne.len() - 1]) < -0.9);
     }
 
     #[test]
@@ -1397,5 +1522,38 @@ mod tests {
         assert!(motion.iter().map(lowest).fold(f64::INFINITY, f64::min) > -0.02);
         assert_eq!(go(&weird), motion, "not deterministic");
         assert_eq!(repeat(&weird, usize::MAX).len(), MAX_REPEAT_KEYS);
+    }
+
+    #[test]
+    fn a_solved_squat_keeps_its_toes_planted() {
+        // Keys as the posture solver makes them: each with its pelvis above the origin, so the
+        // squat's feet are not where the standing feet are until `go` sets them there.
+        use crate::posture::{script::PostureScript, solver};
+        let stand = solver::pose_of(&solver::rest_angles());
+        let script = PostureScript::parse(
+            r#"{"name":"squat","constraints":[
+            {"kind":"level","is":"crouching"},
+            {"kind":"bend","joint":"left_knee","is":"completely_bent"},
+            {"kind":"bend","joint":"right_knee","is":"completely_bent"},
+            {"kind":"orientation","limb":"left_thigh","is":"horizontal"},
+            {"kind":"orientation","limb":"right_thigh","is":"horizontal"},
+            {"kind":"contact","point":"left_foot","on_ground":true},
+            {"kind":"contact","point":"right_foot","on_ground":true},
+            {"kind":"lean","is":"forward"}]}"#,
+        )
+        .expect("a valid squat script");
+        let squat = solver::solve(&script, None).pose;
+        let motion = go(&repeat(
+            &[KeyPose::new(stand, 1.0, 0.3), KeyPose::new(squat, 1.0, 0.3)],
+            2,
+        ));
+        assert_eq!(foot_skating(&motion), 0.0);
+        for toe in [joint::L_FOOT, joint::R_FOOT] {
+            for pose in &motion {
+                assert!(dist_xz(pose[toe], motion[0][toe]) <= PLANT_TOLERANCE);
+            }
+        }
+        assert!(max_joint_speed(&motion) <= MAX_JOINT_SPEED + 1e-9);
+        assert!(motion.iter().map(lowest).fold(f64::INFINITY, f64::min) > -0.02);
     }
 }

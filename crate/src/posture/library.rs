@@ -1,14 +1,94 @@
-//! Named postures: a data file (`static/postures/library.json`, built into the library so the
-//! page needs no extra download) of key poses with their names and synonyms, for the built-in
-//! planner ("does a T-pose") and the page's posture picker.
+//! Named postures and movements made of them: two data files built into the library (so the
+//! page needs no extra download). `static/postures/library.json` holds key poses with their
+//! names and synonyms, for the built-in planner ("does a T-pose") and the page's posture
+//! picker; `static/postures/actions.json` holds movements of several key poses the motion
+//! model does not know (jump, spin, crawl, fall, push-ups, standing up).
 
 use super::script::{PostureScript, ScriptError};
+use super::track::{PostureTrack, TrackKey, MAX_KEYS, MAX_REPEAT};
 use crate::skeleton::BodyPart;
 use serde::Deserialize;
 use std::sync::OnceLock;
 
-/// The library file shipped with the app.
+/// The named postures shipped with the app.
 pub const LIBRARY_JSON: &str = include_str!("../../../static/postures/library.json");
+/// The movements of key poses shipped with the app.
+pub const ACTIONS_JSON: &str = include_str!("../../../static/postures/actions.json");
+
+/// Default ground travel of a key marked `travels` when the prompt says the movement goes
+/// somewhere ("jumps forward"), metres.
+pub const TRAVEL_STEP_M: f64 = 0.5;
+
+/// One key of a movement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActionKey {
+    /// The pose, with its hold.
+    pub script: PostureScript,
+    /// Seconds to move into it.
+    pub transition: f64,
+    /// Turn reached at this key, degrees, + to the left.
+    pub turn_deg: f64,
+    /// A jump into this key: the pelvis's rise in metres.
+    pub jump_m: Option<f64>,
+    /// Forward travel this key always makes (crawling), metres.
+    pub travel_forward_m: f64,
+    /// Whether this key moves [`TRAVEL_STEP_M`] when the prompt gives a direction.
+    pub travels: bool,
+}
+
+/// A movement made of key poses (a jump, a spin, crawling).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Action {
+    /// The name shown to people ("jump").
+    pub name: String,
+    /// Phrases that name it, lower case.
+    pub synonyms: Vec<String>,
+    /// Whether it ends back in the pose it started from.
+    pub returns: bool,
+    /// How many times its keys play when the prompt gives no count (crawling: a few strides).
+    pub repeat: u32,
+    /// The key poses.
+    pub keys: Vec<ActionKey>,
+}
+
+impl Action {
+    /// Every phrase that names the movement, lower case, the name first.
+    pub fn phrases(&self) -> impl Iterator<Item = String> + '_ {
+        std::iter::once(self.name.to_lowercase())
+            .chain(self.synonyms.iter().map(|s| s.to_lowercase()))
+    }
+
+    /// The movement as a whole-body track: played `count` times (once when none is given),
+    /// travelling `direction` (`[left, forward]`, unit or zero) on its
+    /// travelling keys.
+    pub fn track(&self, count: Option<u32>, direction: [f64; 2]) -> PostureTrack {
+        // The movement's own cycle (a few crawling strides) is one movement: its keys are
+        // written out, and the track's repeat is what the prompt counts.
+        let own = (self.repeat as usize).min((MAX_KEYS / self.keys.len()).max(1));
+        let keys = std::iter::repeat_n(&self.keys, own)
+            .flatten()
+            .map(|k| {
+                let step = if k.travels { TRAVEL_STEP_M } else { 0.0 };
+                TrackKey {
+                    script: k.script.clone(),
+                    transition: k.transition,
+                    turn_deg: k.turn_deg,
+                    travel: [
+                        direction[0] * step,
+                        direction[1] * step + k.travel_forward_m,
+                    ],
+                    jump_m: k.jump_m,
+                }
+            })
+            .collect();
+        PostureTrack {
+            parts: BodyPart::ALL.to_vec(),
+            keys,
+            repeat: count.unwrap_or(1).clamp(1, MAX_REPEAT),
+            returns: self.returns,
+        }
+    }
+}
 
 /// One named posture.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,11 +112,32 @@ impl NamedPosture {
     }
 }
 
-/// The named postures.
+/// The named postures and the movements made of key poses.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Library {
     /// The postures in file order.
     pub postures: Vec<NamedPosture>,
+    /// The movements in file order.
+    pub actions: Vec<Action>,
+}
+
+/// Something the library names in a text.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Named<'a> {
+    /// A key pose.
+    Posture(&'a NamedPosture),
+    /// A movement of key poses.
+    Action(&'a Action),
+}
+
+impl<'a> Named<'a> {
+    /// Its name.
+    pub fn name(&self) -> &'a str {
+        match self {
+            Named::Posture(p) => &p.name,
+            Named::Action(a) => &a.name,
+        }
+    }
 }
 
 /// Why a library file was refused: which entry, and why.
@@ -53,6 +154,12 @@ pub enum LibraryError {
     },
     #[error("posture {index} ({name}) has no body parts; list some of left_arm, right_arm, left_leg, right_leg")]
     NoParts { index: usize, name: String },
+    #[error("movement {index} ({name}): {reason}")]
+    Action {
+        index: usize,
+        name: String,
+        reason: String,
+    },
     #[error("the phrase '{phrase}' names both '{first}' and '{second}'")]
     Ambiguous {
         phrase: String,
@@ -83,6 +190,60 @@ struct EntryFile {
 
 fn default_hold() -> f64 {
     super::script::DEFAULT_HOLD_SECONDS
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ActionsFile {
+    #[serde(default, rename = "about")]
+    _about: String,
+    actions: Vec<ActionFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ActionFile {
+    name: String,
+    #[serde(default)]
+    synonyms: Vec<String>,
+    #[serde(default)]
+    returns: bool,
+    #[serde(default = "one")]
+    repeat: u32,
+    keys: Vec<ActionKeyFile>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ActionKeyFile {
+    #[serde(default)]
+    name: Option<String>,
+    /// A named posture of the library, or
+    #[serde(default)]
+    posture: Option<String>,
+    /// a script of the key's own.
+    #[serde(default)]
+    constraints: Option<Vec<serde_json::Value>>,
+    #[serde(default)]
+    hold: Option<f64>,
+    #[serde(default = "default_transition")]
+    transition: f64,
+    #[serde(default)]
+    turn_deg: f64,
+    #[serde(default)]
+    jump_m: Option<f64>,
+    #[serde(default)]
+    travel_forward_m: f64,
+    #[serde(default)]
+    travels: bool,
+}
+
+fn default_transition() -> f64 {
+    super::track::DEFAULT_TRANSITION_SECONDS
 }
 
 impl Library {
@@ -116,25 +277,115 @@ impl Library {
                 script,
             });
         }
-        let library = Library { postures };
+        let library = Library {
+            postures,
+            actions: Vec::new(),
+        };
+        library.unambiguous()?;
+        Ok(library)
+    }
+
+    /// Adds the movements of an actions file; their keys may name the library's postures.
+    pub fn with_actions(mut self, text: &str) -> Result<Library, LibraryError> {
+        let file: ActionsFile =
+            serde_json::from_str(text).map_err(|e| LibraryError::Shape(e.to_string()))?;
+        for (i, a) in file.actions.into_iter().enumerate() {
+            let fail = |reason: String| LibraryError::Action {
+                index: i + 1,
+                name: a.name.clone(),
+                reason,
+            };
+            if a.keys.is_empty() || a.keys.len() > MAX_KEYS {
+                return Err(fail(format!("a movement has 1 to {MAX_KEYS} keys")));
+            }
+            if !(1..=MAX_REPEAT).contains(&a.repeat) {
+                return Err(fail(format!("repeat is 1 to {MAX_REPEAT}")));
+            }
+            let mut keys = Vec::with_capacity(a.keys.len());
+            for (k, key) in a.keys.iter().enumerate() {
+                let mut script = match (&key.posture, &key.constraints) {
+                    (Some(name), None) => {
+                        self.get(name).map(|p| p.script.clone()).ok_or_else(|| {
+                            fail(format!("key {}: no posture is called '{name}'", k + 1))
+                        })?
+                    }
+                    (None, Some(constraints)) => PostureScript::from_value(serde_json::json!({
+                        "name": key.name.clone().unwrap_or_else(|| a.name.clone()),
+                        "constraints": constraints,
+                    }))
+                    .map_err(|e| fail(format!("key {}: {e}", k + 1)))?,
+                    _ => {
+                        return Err(fail(format!(
+                            "key {}: give either \"posture\" or \"constraints\"",
+                            k + 1
+                        )))
+                    }
+                };
+                if let Some(hold) = key.hold {
+                    script.hold = hold;
+                }
+                if let Some(name) = &key.name {
+                    script.name = Some(name.clone());
+                }
+                let script = script
+                    .check()
+                    .map_err(|e| fail(format!("key {}: {e}", k + 1)))?;
+                keys.push(ActionKey {
+                    script,
+                    transition: key.transition,
+                    turn_deg: key.turn_deg,
+                    jump_m: key.jump_m,
+                    travel_forward_m: key.travel_forward_m,
+                    travels: key.travels,
+                });
+            }
+            let action = Action {
+                name: a.name.clone(),
+                synonyms: a.synonyms.clone(),
+                returns: a.returns,
+                repeat: a.repeat,
+                keys,
+            };
+            // The track checks the numbers (times, turns, jumps) once, as a plan would.
+            action.track(None, [0.0, 1.0]).checked().map_err(fail)?;
+            self.actions.push(action);
+        }
+        self.unambiguous()?;
+        Ok(self)
+    }
+
+    /// No phrase may name two things: the planner could not tell which was meant.
+    fn unambiguous(&self) -> Result<(), LibraryError> {
         let mut seen: Vec<(String, &str)> = Vec::new();
-        for p in &library.postures {
-            for phrase in p.phrases() {
+        for named in self.all() {
+            let phrases: Vec<String> = match named {
+                Named::Posture(p) => p.phrases().collect(),
+                Named::Action(a) => a.phrases().collect(),
+            };
+            for phrase in phrases {
                 let phrase = normalise(&phrase);
                 match seen.iter().find(|(s, _)| *s == phrase) {
-                    Some((_, first)) if *first != p.name => {
+                    Some((_, first)) if *first != named.name() => {
                         return Err(LibraryError::Ambiguous {
                             phrase,
                             first: first.to_string(),
-                            second: p.name.clone(),
+                            second: named.name().to_string(),
                         })
                     }
                     Some(_) => {}
-                    None => seen.push((phrase, &p.name)),
+                    None => seen.push((phrase, named.name())),
                 }
             }
         }
-        Ok(library)
+        Ok(())
+    }
+
+    /// Every posture, then every movement.
+    pub fn all(&self) -> impl Iterator<Item = Named<'_>> {
+        self.postures
+            .iter()
+            .map(Named::Posture)
+            .chain(self.actions.iter().map(Named::Action))
     }
 
     /// The library shipped with the app, read once.
@@ -142,7 +393,9 @@ impl Library {
         static LIBRARY: OnceLock<Library> = OnceLock::new();
         LIBRARY.get_or_init(|| {
             // The file is part of the build and a test reads it, so a broken file never ships.
-            Library::parse(LIBRARY_JSON).expect("static/postures/library.json is checked by a test")
+            Library::parse(LIBRARY_JSON)
+                .and_then(|l| l.with_actions(ACTIONS_JSON))
+                .expect("static/postures/{library,actions}.json are checked by a test")
         })
     }
 
@@ -154,13 +407,17 @@ impl Library {
             .find(|p| p.phrases().any(|ph| normalise(&ph) == wanted))
     }
 
-    /// Postures named in a text, with the byte range of the longest phrase that names each,
-    /// in the order they appear; overlapping mentions keep the longer phrase.
-    pub fn mentions(&self, text: &str) -> Vec<(std::ops::Range<usize>, &NamedPosture)> {
+    /// Postures and movements named in a text, with the byte range of the longest phrase that
+    /// names each, in the order they appear; overlapping mentions keep the longer phrase.
+    pub fn mentions(&self, text: &str) -> Vec<(std::ops::Range<usize>, Named<'_>)> {
         let (flat, map) = normalise_with_map(text);
-        let mut found: Vec<(std::ops::Range<usize>, &NamedPosture)> = Vec::new();
-        for p in &self.postures {
-            for phrase in p.phrases() {
+        let mut found: Vec<(std::ops::Range<usize>, Named<'_>)> = Vec::new();
+        for named in self.all() {
+            let phrases: Vec<String> = match named {
+                Named::Posture(p) => p.phrases().collect(),
+                Named::Action(a) => a.phrases().collect(),
+            };
+            for phrase in phrases {
                 let phrase = normalise(&phrase);
                 if phrase.is_empty() {
                     continue;
@@ -174,7 +431,7 @@ impl Library {
                     if bounded {
                         let last = map[end - 1];
                         let stop = last + text[last..].chars().next().map_or(1, char::len_utf8);
-                        found.push((map[start]..stop, p));
+                        found.push((map[start]..stop, named));
                     }
                     from = start + 1;
                 }
@@ -182,13 +439,13 @@ impl Library {
         }
         // Longer phrases first, then keep those that overlap nothing kept.
         found.sort_by_key(|(r, _)| (std::cmp::Reverse(r.len()), r.start));
-        let mut kept: Vec<(std::ops::Range<usize>, &NamedPosture)> = Vec::new();
-        for (r, p) in found {
+        let mut kept: Vec<(std::ops::Range<usize>, Named<'_>)> = Vec::new();
+        for (r, n) in found {
             if kept
                 .iter()
                 .all(|(k, _)| r.end <= k.start || r.start >= k.end)
             {
-                kept.push((r, p));
+                kept.push((r, n));
             }
         }
         kept.sort_by_key(|(r, _)| r.start);
@@ -268,7 +525,7 @@ mod tests {
         let names: Vec<&str> = library
             .mentions(text)
             .iter()
-            .map(|(_, p)| p.name.as_str())
+            .map(|(_, n)| n.name())
             .collect();
         assert_eq!(names, ["squat", "T-pose", "kneel on both knees"]);
         let (range, _) = &library.mentions(text)[1];

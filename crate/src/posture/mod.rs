@@ -11,6 +11,7 @@ pub mod go;
 pub mod library;
 pub mod script;
 pub mod solver;
+pub mod track;
 
 #[cfg(test)]
 mod tests;

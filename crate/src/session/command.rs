@@ -78,9 +78,11 @@ pub enum Command {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Motion {
     pub tokens: MotionTokens,
-    /// Joint positions per frame: 22 joints, metres, Y up, starting at the origin facing +Z.
+    /// Joint positions per frame: 22 joints, metres, Y up, starting at the origin facing +Z,
+    /// every bone of the reference skeleton's length (see [`crate::skeleton::fixed_bones`]).
     pub joints: Vec<[[f32; 3]; 22]>,
-    /// HumanML3D features per frame (not normalised), with the plan's paths laid on the root.
+    /// HumanML3D features per frame (not normalised), with the plan's paths laid on the root;
+    /// they describe exactly `joints`.
     #[serde(with = "feature_rows")]
     pub features: Features,
 }

@@ -25,7 +25,7 @@ use crate::agents::llm::Transport;
 use crate::agents::pipeline::{self, RunOptions};
 use crate::agents::reviewer::Scorer;
 use crate::dataset::Vocabulary;
-use crate::features::features_to_joints;
+use crate::features::{features_to_joints, with_reference_bones};
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
 use crate::model::motion_model::sampling;
 use crate::model::tokens::MotionTokens;
@@ -305,10 +305,27 @@ impl Session {
 
     /// The motion of `tokens` with the paths of `plan` laid on its root; the notes say which
     /// paths could not be laid.
+    ///
+    /// Every motion the engine answers with is made here, and here it gets the one skeleton
+    /// ([`with_reference_bones`]): the model predicts each joint on its own, so its bones
+    /// stretch; fixed once in the features, the joints shown, the BVH, the JSON and both NPY
+    /// exports all describe the same motion on the same bones.
     async fn motion(&self, tokens: MotionTokens, plan: Option<&Plan>) -> (Motion, Vec<String>) {
         let (features, notes) = match plan {
             Some(plan) => pipeline::motion_features(&self.model, plan, &tokens).await,
             None => (self.model.features(&tokens).await, Vec::new()),
+        };
+        let features = with_reference_bones(&features);
+        let (features, notes) = match plan {
+            Some(plan) if plan.segments.iter().any(|s| s.postures.is_some()) => {
+                let (laid, posture_notes) = pipeline::lay_postures(plan, &tokens, &features);
+                // Key poses keep the bone lengths but shape the hips and collars their own
+                // way, which a rigid skeleton (the BVH's) cannot follow: once more on the
+                // one skeleton, so posture-built motions leave here as every other does.
+                let laid = with_reference_bones(&laid);
+                (laid, notes.into_iter().chain(posture_notes).collect())
+            }
+            _ => (features, notes),
         };
         let joints = features_to_joints(&features)
             .iter()

@@ -65,7 +65,7 @@ pub fn plan_events(plan: &Plan) -> Vec<PlanEvent> {
         plan.segments
             .iter()
             .enumerate()
-            .map(|(i, s)| PlanEvent::Decomposed(i, s.clone())),
+            .map(|(i, s)| PlanEvent::Decomposed(i, Box::new(s.clone()))),
     );
     events
 }
@@ -109,7 +109,7 @@ pub fn run_steps(plan: &Plan, rounds: usize) -> u64 {
             let mut texts: Vec<String> = s.parts.edits().into_iter().map(|(_, t)| t).collect();
             texts.sort();
             texts.dedup();
-            1 + texts.len() + rounds
+            1 + texts.len() + if s.is_posture_segment() { 0 } else { rounds }
         })
         .sum();
     (per_segment + usize::from(plan.segments.len() > 1)) as u64

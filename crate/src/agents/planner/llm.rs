@@ -23,7 +23,7 @@ pub enum PlanEvent {
     /// The segments' texts and durations in seconds.
     Segmented(Vec<(String, f64)>),
     /// Segment `index` has its base motion, part edits and path.
-    Decomposed(usize, Segment),
+    Decomposed(usize, Box<Segment>),
 }
 
 /// Plans `prompt` with an LLM, step by step, falling back to the built-in rules for any step
@@ -88,7 +88,7 @@ pub async fn plan<T: Transport>(
                 s
             }
         };
-        progress(&PlanEvent::Decomposed(index, segment.clone()));
+        progress(&PlanEvent::Decomposed(index, Box::new(segment.clone())));
         segments.push(segment);
     }
     Plan {
@@ -294,6 +294,7 @@ impl DecomposeReply {
                 right_leg: part(&self.right_leg, "right_leg")?,
             },
             trajectory,
+            postures: None,
         })
     }
 }

@@ -8,4 +8,5 @@
 pub mod lexicon;
 pub mod llm;
 pub mod offline;
+pub mod postures;
 pub mod prompt_set;

@@ -14,6 +14,7 @@
 //!    similarity when an embedder is given, and dropped otherwise, with a note either way.
 
 use super::lexicon::{self, Action, Direction, Side};
+use super::postures;
 use crate::plan::{
     clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS, MAX_TEXT_CHARS,
 };
@@ -26,6 +27,17 @@ pub type Embedder<'a> = &'a dyn Fn(&str) -> Vec<f32>;
 
 /// Lowest cosine similarity at which an unknown clause is mapped onto a training action.
 pub const NEAREST_MIN_SIMILARITY: f32 = 0.35;
+
+/// How a note says a clause was planned as a different movement than it asks for.
+pub const SUBSTITUTED: &str = "is not a movement the model knows";
+/// How a note says a clause was left out of the plan.
+pub const LEFT_OUT: &str = "names no movement the model makes; left out";
+
+/// Whether a plan note says a clause went unplanned: planned as a different movement (the
+/// nearest one the model knows) or left out.
+pub fn is_unplanned_note(note: &str) -> bool {
+    note.contains(SUBSTITUTED) || note.contains(LEFT_OUT)
+}
 
 /// Longest prompt read, in characters; the rest is ignored with a note.
 pub const MAX_PROMPT_CHARS: usize = 2000;
@@ -46,12 +58,47 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
     let mut previous: Option<Action> = None;
     for clause in clauses(&text) {
         let words: Vec<&str> = clause.iter().map(String::as_str).collect();
-        let found = match movements(&words, previous) {
+        let model = movements(&words, previous);
+        let model_segment = || match &model {
+            Some(found) => segment(&words, found, style.as_deref()),
+            None => segment(
+                &words,
+                &Movements {
+                    base: Action::Walk(Direction::Forward),
+                    gestures: Vec::new(),
+                },
+                style.as_deref(),
+            ),
+        };
+        let model_parts = model.as_ref().map(|m| (m.base, m.gestures.as_slice()));
+        if let Some(planned) = postures::plan_clause(&words, model_parts, &model_segment) {
+            notes.extend(planned.notes);
+            previous = None;
+            segments.push(planned.segment);
+            continue;
+        }
+        if let (None, Some(stay)) = (&model, postures::stay(&words)) {
+            let held = match (stay, segments.last()) {
+                (postures::Stay::Hold, Some(last)) => postures::hold_segment(&words, last),
+                _ => None,
+            };
+            match (held, segments.last_mut()) {
+                (Some(held), _) => segments.push(held),
+                (None, Some(last)) if stay != postures::Stay::Passing => {
+                    // Staying as one is: the movement before lasts longer.
+                    last.seconds = clamp_seconds(last.seconds + postures::HOLD_EXTRA_SECONDS)
+                        .unwrap_or(last.seconds);
+                }
+                _ => {}
+            }
+            continue;
+        }
+        let found = match model {
             Some(found) => found,
             None => match nearest_action(&words, embed) {
                 Some((action, similarity)) => {
                     notes.push(format!(
-                        "\"{}\" is not a movement the model knows; used the nearest one, \"{}\" \
+                        "\"{}\" {SUBSTITUTED}; used the nearest one, \"{}\" \
                          (similarity {similarity:.2})",
                         words.join(" "),
                         action.verb_phrase()
@@ -63,10 +110,7 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
                 }
                 None => {
                     if !words.is_empty() {
-                        notes.push(format!(
-                            "\"{}\" names no movement the model makes; left out",
-                            words.join(" ")
-                        ));
+                        notes.push(format!("\"{}\" {LEFT_OUT}", words.join(" ")));
                     }
                     continue;
                 }
@@ -89,6 +133,7 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
             base: fallback,
             parts: PartEdits::default(),
             trajectory: None,
+            postures: None,
         });
     }
     if segments.len() > MAX_SEGMENTS {
@@ -184,7 +229,9 @@ fn starts_verb(words: &[String]) -> bool {
     while i < words.len() && i < 4 {
         let w = words[i].as_str();
         let next: Vec<&str> = words[i + 1..].iter().take(3).map(String::as_str).collect();
-        if lexicon::is_finite_verb(w) && !(w == "turn" && next.first() == Some(&"to")) {
+        if (lexicon::is_finite_verb(w) || postures::is_posture_verb(w))
+            && !(w == "turn" && next.first() == Some(&"to"))
+        {
             // "left" after "turn" is part of the verb; a bare side word is not a verb.
             return action_or_other(w, &next);
         }
@@ -373,10 +420,15 @@ fn order(chunks: Vec<Chunk>) -> Vec<Vec<String>> {
 fn soft_join(left: &[String], right: &[String]) -> bool {
     let l: Vec<&str> = left.iter().map(String::as_str).collect();
     let r: Vec<&str> = right.iter().map(String::as_str).collect();
-    let (Some(a), Some(b)) = (movements(&l, None), movements(&r, None)) else {
+    let Some(b) = movements(&r, None) else {
         return false;
     };
-    a.base.is_locomotion() && b.base.is_gesture() && b.gestures.is_empty()
+    let gesture = b.base.is_gesture() && b.gestures.is_empty();
+    // A gesture rides on a walk, or on a posture the model does not know ("kneels and raises
+    // the right hand").
+    let carries =
+        movements(&l, None).is_some_and(|a| a.base.is_locomotion()) || postures::names_posture(&l);
+    gesture && carries
 }
 
 /// The movements of one clause; `previous` lends its gesture to a clause with no verb ("then
@@ -658,6 +710,7 @@ fn segment(words: &[&str], found: &Movements, style: Option<&str>) -> Segment {
         base,
         parts,
         trajectory,
+        postures: None,
     }
 }
 

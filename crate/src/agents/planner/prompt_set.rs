@@ -43,6 +43,8 @@ pub struct PromptResult {
     pub planned_parts: Vec<String>,
     pub expected_path: bool,
     pub planned_path: bool,
+    /// Clauses the planner substituted or left out (its notes say so).
+    pub unplanned: Vec<String>,
 }
 
 /// A planner over the whole set.
@@ -55,6 +57,8 @@ pub struct SetReport {
     pub parts_rate: f64,
     /// Fraction where a path was planned exactly when one was asked for.
     pub path_rate: f64,
+    /// Fraction of prompts with no clause substituted or left out.
+    pub planned_rate: f64,
     pub results: Vec<PromptResult>,
 }
 
@@ -72,16 +76,30 @@ impl SetReport {
                 "{mark} {}/{} segments  {}\n",
                 r.planned_segments, r.expected_segments, r.prompt
             );
+            for u in &r.unplanned {
+                out += &format!("    unplanned: {u}\n");
+            }
         }
         out += &format!(
-            "segment counts match in {:.0} % of {} prompts; part edits {:.0} %; paths {:.0} %\n",
+            "segment counts match in {:.0} % of {} prompts; no clause unplanned in {:.0} %; part \
+             edits {:.0} %; paths {:.0} %\n",
             100.0 * self.segment_rate,
             self.prompts,
+            100.0 * self.planned_rate,
             100.0 * self.parts_rate,
             100.0 * self.path_rate
         );
         out
     }
+}
+
+/// The consecutive movements of a plan: one per segment, except that a posture track played
+/// several times (squats × 3, five push-ups) counts each time, as a reader counts them.
+pub fn movements(plan: &Plan) -> usize {
+    plan.segments
+        .iter()
+        .map(|s| s.postures.as_ref().map_or(1, |t| t.repeat as usize))
+        .sum()
 }
 
 /// The body parts a plan edits, sorted by name.
@@ -117,11 +135,17 @@ pub fn score_prompts(prompts: &[SetPrompt], planner: &mut dyn FnMut(&str) -> Pla
             PromptResult {
                 prompt: p.prompt.clone(),
                 expected_segments: p.segments,
-                planned_segments: plan.segments.len(),
+                planned_segments: movements(&plan),
                 expected_parts,
                 planned_parts: edited_parts(&plan),
                 expected_path: p.path.is_some(),
                 planned_path: plan.segments.iter().any(|s| s.trajectory.is_some()),
+                unplanned: plan
+                    .notes
+                    .iter()
+                    .filter(|n| super::offline::is_unplanned_note(n))
+                    .cloned()
+                    .collect(),
             }
         })
         .collect();
@@ -133,6 +157,7 @@ pub fn score_prompts(prompts: &[SetPrompt], planner: &mut dyn FnMut(&str) -> Pla
         segment_rate: rate(&|r| r.planned_segments == r.expected_segments),
         parts_rate: rate(&|r| r.planned_parts == r.expected_parts),
         path_rate: rate(&|r| r.planned_path == r.expected_path),
+        planned_rate: rate(&|r| r.unplanned.is_empty()),
         results,
     }
 }

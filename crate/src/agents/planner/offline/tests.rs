@@ -208,21 +208,21 @@ fn context_that_is_not_motion_is_dropped() {
 fn unknown_movements_go_to_the_nearest_action_with_an_embedder() {
     // A toy embedder: one dimension per word, so "spins around dancing" is nearest to
     // "a person dances" by shared words. MiniLM does this by meaning.
-    let vocab = ["person", "dances", "dancing", "pirouette", "bows", "walks"];
+    let vocab = ["person", "dances", "dancing", "cartwheel", "bows", "walks"];
     let embed = |s: &str| -> Vec<f32> {
         let mut v: Vec<f32> = vocab
             .iter()
             .map(|w| s.split_whitespace().filter(|x| x == w).count() as f32)
             .collect();
-        if s.contains("pirouette") {
+        if s.contains("cartwheel") {
             v[1] += 1.0;
         }
         v
     };
-    let with = plan("a ballerina does a pirouette", Some(&embed));
+    let with = plan("a ballerina does a cartwheel", Some(&embed));
     assert_eq!(with.segments[0].base, "a person dances", "{with:#?}");
     assert!(with.notes.iter().any(|n| n.contains("nearest")));
-    let without = plan("a ballerina does a pirouette", None);
+    let without = plan("a ballerina does a cartwheel", None);
     assert_eq!(without.segments.len(), 1);
     assert!(without
         .notes

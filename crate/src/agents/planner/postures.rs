@@ -1,0 +1,573 @@
+//! The built-in planner's key postures: clauses that name a posture ("strikes a T-pose",
+//! "kneels on one knee") or a movement made of key poses ("jumps", "crawls forward", "does
+//! five push-ups") from the posture library ([`crate::posture::library`]) become posture
+//! tracks, where the motion model does not know them.
+//!
+//! - A clause with a walk or run and postures of the arms only keeps the model's motion and
+//!   holds the postures on those arms ("walks in a zigzag holding both arms out in a T").
+//! - Otherwise the postures and movements make a posture segment: one movement's keys (with
+//!   the arm postures laid into each key), or one key merged from the named postures (a squat
+//!   with a T-pose's arms). Gestures the model knows in the same clause ("kneels and raises the
+//!   right hand") stay the model's: the track then leaves those arms to it.
+//! - A clause that only asks to stay ("waits", "rests", "lies still") holds the pose before.
+
+use super::lexicon::{self, Action};
+use crate::plan::{clamp_seconds, PartEdits, Segment};
+use crate::posecodes::{BodyPoint, Limb, Support};
+use crate::posture::library::{Library, Named, NamedPosture};
+use crate::posture::script::{Constraint, Hinge, PostureScript};
+use crate::posture::track::{PostureTrack, DEFAULT_TRANSITION_SECONDS};
+use crate::skeleton::BodyPart;
+
+/// Seconds added to the segment before for a clause that only asks to stay still.
+pub const HOLD_EXTRA_SECONDS: f64 = 1.5;
+
+/// Verbs that start a clause about postures (so "and kneels" begins a new movement), beyond
+/// those the model's own lexicon knows.
+pub fn is_posture_verb(word: &str) -> bool {
+    const VERBS: &[&str] = &[
+        "squat",
+        "squats",
+        "crouch",
+        "crouches",
+        "kneel",
+        "kneels",
+        "sit",
+        "sits",
+        "lie",
+        "lies",
+        "lay",
+        "lays",
+        "crawl",
+        "crawls",
+        "creep",
+        "creeps",
+        "fall",
+        "falls",
+        "rise",
+        "rises",
+        "get",
+        "gets",
+        "hop",
+        "hops",
+        "leap",
+        "leaps",
+        "jump",
+        "jumps",
+        "spin",
+        "spins",
+        "twirl",
+        "twirls",
+        "bend",
+        "bends",
+        "stretch",
+        "stretches",
+        "flex",
+        "flexes",
+        "strike",
+        "strikes",
+        "hold",
+        "holds",
+        "put",
+        "puts",
+        "cover",
+        "covers",
+        "clap",
+        "claps",
+        "pray",
+        "prays",
+        "dab",
+        "dabs",
+        "land",
+        "lands",
+        "lower",
+        "lowers",
+        "roll",
+        "rolls",
+        "push",
+        "pushes",
+        "meditate",
+        "meditates",
+        "dive",
+        "dives",
+        "trip",
+        "trips",
+        "collapse",
+        "collapses",
+        "reach",
+        "reaches",
+        "uncross",
+        "uncrosses",
+        "cross",
+        "crosses",
+        "fly",
+        "flies",
+        "stand",
+        "stands",
+        "rest",
+        "rests",
+        "wait",
+        "waits",
+        "relax",
+        "relaxes",
+        "stay",
+        "stays",
+        "pose",
+        "poses",
+        "balance",
+        "balances",
+        "lunge",
+        "lunges",
+        "touch",
+        "touches",
+        "slide",
+        "slides",
+        "open",
+        "opens",
+        "spread",
+        "spreads",
+    ];
+    VERBS.contains(&word)
+}
+
+/// Words of a plain raise or wave of a hand ("raises both arms", "waves the left hand"): the
+/// model makes those itself, so a posture named by these words alone stays the model's.
+const PLAIN_GESTURE_WORDS: &[&str] = &[
+    "raise", "raises", "raising", "raised", "lift", "lifts", "lifting", "wave", "waves", "waving",
+    "the", "a", "his", "her", "their", "its", "left", "right", "both", "one", "hand", "hands",
+    "arm", "arms", "up", "high", "in", "into", "air", "overhead",
+];
+
+/// What a clause with no movement of its own asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stay {
+    /// Nothing new: leaving one pose on the way to the next ("trips", "lands", "uncrosses
+    /// them").
+    Passing,
+    /// Waiting as one is ("waits", "rests", "pauses"): the movement before lasts longer.
+    Longer,
+    /// Holding the pose as a movement of its own ("meditates for a while", "lies still").
+    Hold,
+}
+
+/// Whether a clause with no movement only asks to stay as one is, and how.
+pub fn stay(words: &[&str]) -> Option<Stay> {
+    const PASSING: &[&str] = &[
+        "trip",
+        "trips",
+        "tripping",
+        "stumble",
+        "stumbles",
+        "stumbling",
+        "slip",
+        "slips",
+        "slipping",
+        "land",
+        "lands",
+        "landing",
+        "uncross",
+        "uncrosses",
+        "release",
+        "releases",
+        "loses",
+    ];
+    const LONGER: &[&str] = &[
+        "wait", "waits", "waiting", "rest", "rests", "resting", "pause", "pauses", "relax",
+        "relaxes", "stop", "stops", "freeze", "freezes", "remain", "remains", "breath", "breathe",
+        "breathes",
+    ];
+    const HOLD: &[&str] = &[
+        "still",
+        "meditate",
+        "meditates",
+        "meditating",
+        "stays",
+        "stay",
+    ];
+    let has = |list: &[&str]| words.iter().any(|w| list.contains(w));
+    if has(HOLD) {
+        Some(Stay::Hold)
+    } else if has(LONGER) {
+        Some(Stay::Longer)
+    } else if has(PASSING) {
+        Some(Stay::Passing)
+    } else {
+        None
+    }
+}
+
+/// A segment that holds the last key pose of `previous` (a posture segment) for a while.
+pub fn hold_segment(words: &[&str], previous: &Segment) -> Option<Segment> {
+    let track = previous.postures.as_ref().filter(|t| t.whole_body())?;
+    let last = track.keys.last()?;
+    let mut script = last.script.clone();
+    script.hold = HOLD_EXTRA_SECONDS;
+    let mut held = PostureTrack::holding(track.parts.clone(), script);
+    held.keys[0].transition = 0.3;
+    let subject_free: Vec<&str> = words
+        .iter()
+        .skip_while(|w| lexicon::is_subject_word(w) || is_subject_noun(w))
+        .copied()
+        .collect();
+    Some(Segment {
+        text: format!("a person {}", subject_free.join(" ")),
+        seconds: clamp_seconds(held.natural_seconds()).unwrap_or(2.0),
+        base: previous.base.clone(),
+        parts: PartEdits::default(),
+        trajectory: None,
+        postures: Some(held),
+    })
+}
+
+/// Whether a clause names a posture or movement of the library that the model does not make
+/// itself (so that "kneels and raises the right hand" stays one movement).
+pub fn names_posture(words: &[&str]) -> bool {
+    Library::builtin()
+        .mentions(&words.join(" "))
+        .iter()
+        .any(|(_, n)| !matches!(n, Named::Posture(p) if arms_only(p)))
+}
+
+/// Which part of the body a constraint is about, to merge two postures (a squat's legs with a
+/// T-pose's arms).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Region {
+    Arms,
+    Legs,
+    Torso,
+    /// Hands with feet or knees (touching the toes): both at once.
+    Whole,
+}
+
+fn point_region(p: BodyPoint) -> Region {
+    use BodyPoint::*;
+    match p {
+        LeftHand | RightHand | LeftElbow | RightElbow => Region::Arms,
+        LeftKnee | RightKnee | LeftFoot | RightFoot | LeftHip | RightHip => Region::Legs,
+        _ => Region::Torso,
+    }
+}
+
+fn region(c: &Constraint) -> Region {
+    let pair = |a: BodyPoint, b: BodyPoint| match (point_region(a), point_region(b)) {
+        (Region::Arms, Region::Legs) | (Region::Legs, Region::Arms) => Region::Whole,
+        (Region::Arms, _) | (_, Region::Arms) => Region::Arms,
+        (Region::Legs, _) | (_, Region::Legs) => Region::Legs,
+        _ => Region::Torso,
+    };
+    match *c {
+        Constraint::Bend { joint, .. } => match joint {
+            Hinge::LeftElbow | Hinge::RightElbow => Region::Arms,
+            Hinge::LeftKnee | Hinge::RightKnee => Region::Legs,
+        },
+        Constraint::Distance { a, b, .. } | Constraint::Relation { a, b, .. } => pair(a, b),
+        Constraint::Orientation { limb, .. } => match limb {
+            Limb::LeftUpperArm | Limb::RightUpperArm | Limb::LeftForearm | Limb::RightForearm => {
+                Region::Arms
+            }
+            Limb::Torso => Region::Torso,
+            _ => Region::Legs,
+        },
+        Constraint::Contact { point, .. } => match point {
+            Support::LeftHand | Support::RightHand => Region::Whole,
+            _ => Region::Legs,
+        },
+        Constraint::Lean { .. } | Constraint::Twist { .. } => Region::Torso,
+        Constraint::Level { .. } => Region::Legs,
+    }
+}
+
+/// `base` with its arms taken from `arms` (an arms-only posture): the base keeps its legs,
+/// torso and level; the arms posture adds its arm constraints and any torso constraint the
+/// base leaves open. `None` when the two contradict each other.
+fn with_arms(base: &PostureScript, arms: &PostureScript) -> Option<PostureScript> {
+    let mut constraints: Vec<Constraint> = base
+        .constraints
+        .iter()
+        .filter(|c| !matches!(region(c), Region::Arms))
+        .copied()
+        .collect();
+    let base_has_torso = base.constraints.iter().any(|c| region(c) == Region::Torso);
+    for c in &arms.constraints {
+        match region(c) {
+            Region::Arms => constraints.push(*c),
+            Region::Torso if !base_has_torso => constraints.push(*c),
+            _ => {}
+        }
+    }
+    let name = match (&base.name, &arms.name) {
+        (Some(a), Some(b)) => Some(format!("{a} with {b}")),
+        (a, b) => a.clone().or_else(|| b.clone()),
+    };
+    PostureScript {
+        name,
+        hold: base.hold.max(arms.hold),
+        constraints,
+    }
+    .check()
+    .ok()
+}
+
+fn arms_only(p: &NamedPosture) -> bool {
+    p.parts
+        .iter()
+        .all(|part| matches!(part, BodyPart::LeftArm | BodyPart::RightArm))
+}
+
+/// What the planner makes of a clause that names postures.
+pub struct PostureClause {
+    /// The segment (with its track).
+    pub segment: Segment,
+    /// Notes for the plan (postures that could not be combined).
+    pub notes: Vec<String>,
+}
+
+/// The segment for a clause that names postures or movements of the library, or `None` when
+/// it names none (or only what the model's own movement already is, such as "bows").
+/// `model` is what the model's lexicon found in the clause (base and gestures);
+/// `model_segment` builds the model's own segment for it.
+pub fn plan_clause(
+    words: &[&str],
+    model: Option<(Action, &[Action])>,
+    model_segment: &dyn Fn() -> Segment,
+) -> Option<PostureClause> {
+    let text = words.join(" ");
+    let library = Library::builtin();
+    let mut mentions = library.mentions(&text);
+    // A whole-body movement the model knows ("bows") stays the model's.
+    let model_words: Vec<&str> = words
+        .iter()
+        .enumerate()
+        .filter(|(i, w)| {
+            let next = &words[i + 1..];
+            let prev: Vec<&str> = words[..*i].iter().rev().copied().collect();
+            lexicon::action_word(w, next, &prev).is_some_and(|a| !a.is_gesture())
+        })
+        .map(|(_, w)| *w)
+        .collect();
+    mentions.retain(|(range, _)| {
+        let phrase = &text[range.clone()];
+        let plain_raise = phrase.split(' ').all(|w| PLAIN_GESTURE_WORDS.contains(&w));
+        !plain_raise && !phrase.split(' ').any(|w| model_words.contains(&w))
+    });
+    if mentions.is_empty() {
+        return None;
+    }
+    let mut notes = Vec::new();
+    let postures: Vec<&NamedPosture> = mentions
+        .iter()
+        .filter_map(|(_, n)| match n {
+            Named::Posture(p) => Some(*p),
+            Named::Action(_) => None,
+        })
+        .collect();
+    let action = mentions.iter().find_map(|(r, n)| match n {
+        Named::Action(a) => Some((r.clone(), *a)),
+        Named::Posture(_) => None,
+    });
+    let (arm_postures, body_postures): (Vec<&NamedPosture>, Vec<&NamedPosture>) =
+        postures.iter().partition(|p| arms_only(p));
+    let locomotion = model.is_some_and(|(base, _)| base.is_locomotion());
+    let gestures: Vec<Action> = model
+        .map(|(base, gestures)| {
+            std::iter::once(base)
+                .filter(|b| b.is_gesture())
+                .chain(gestures.iter().copied())
+                .collect()
+        })
+        .unwrap_or_default();
+
+    // The model's walk or run, with the arms held in a posture.
+    if locomotion && action.is_none() && body_postures.is_empty() {
+        let mut segment = model_segment();
+        let arms = merge_arms(&arm_postures, &mut notes)?;
+        let parts: Vec<BodyPart> = arm_postures.iter().flat_map(|p| p.parts.clone()).collect();
+        for part in &parts {
+            segment.parts.set(*part, None);
+        }
+        segment.text = format!("{} holding {}", segment.text, describe_names(&arm_postures));
+        segment.postures = Some(PostureTrack::holding(parts, arms));
+        return Some(PostureClause { segment, notes });
+    }
+
+    let count = repetitions(words, &text, action.as_ref().map(|(r, _)| r.start));
+    let mut track = match &action {
+        Some((_, a)) => {
+            let mut track = a.track(count, direction(words));
+            if let Some(arms) = merge_arms(&arm_postures, &mut notes) {
+                for key in &mut track.keys {
+                    match with_arms(&key.script, &arms) {
+                        Some(s) => key.script = s,
+                        None => notes.push(format!(
+                            "{} cannot be held during {}; left out",
+                            describe_names(&arm_postures),
+                            a.name
+                        )),
+                    }
+                }
+            }
+            track
+        }
+        None => {
+            let mut script = match body_postures.first() {
+                Some(p) => p.script.clone(),
+                None => merge_arms(&arm_postures, &mut notes)?,
+            };
+            for extra in body_postures.iter().skip(1) {
+                notes.push(format!(
+                    "{} and {} in one movement: kept {}",
+                    body_postures[0].name, extra.name, body_postures[0].name
+                ));
+            }
+            if !body_postures.is_empty() {
+                if let Some(arms) = merge_arms(&arm_postures, &mut notes) {
+                    match with_arms(&script, &arms) {
+                        Some(s) => script = s,
+                        None => notes.push(format!(
+                            "{} cannot be combined with {}; kept {}",
+                            describe_names(&arm_postures),
+                            body_postures[0].name,
+                            body_postures[0].name
+                        )),
+                    }
+                }
+            }
+            let mut track = PostureTrack::holding(BodyPart::ALL.to_vec(), script);
+            if let Some(n) = count.filter(|n| *n > 1) {
+                track.repeat = n;
+                track.returns = true;
+            }
+            track
+        }
+    };
+    // Gestures the model knows stay its own: the track leaves those arms to it.
+    let gesture_arms: Vec<BodyPart> = gestures.iter().flat_map(|g| g.arms().to_vec()).collect();
+    let mut parts = PartEdits::default();
+    let mut base = "a person stands still".to_string();
+    if let Some(g) = gestures.first() {
+        base = g.caption();
+        for g in &gestures {
+            for arm in g.arms() {
+                parts.set(*arm, Some(g.caption()));
+            }
+        }
+        track.parts.retain(|p| !gesture_arms.contains(p));
+    }
+    let track = track.checked().ok()?;
+    // The key poses, and the way out into whatever comes next.
+    let seconds =
+        clamp_seconds(track.natural_seconds() + DEFAULT_TRANSITION_SECONDS).unwrap_or(2.0);
+    let subject_free: Vec<&str> = words
+        .iter()
+        .skip_while(|w| lexicon::is_subject_word(w) || is_subject_noun(w))
+        .copied()
+        .collect();
+    let segment = Segment {
+        text: format!("a person {}", subject_free.join(" ")),
+        seconds,
+        base,
+        parts,
+        trajectory: None,
+        postures: Some(track),
+    };
+    Some(PostureClause { segment, notes })
+}
+
+/// Nouns prompts use for the person ("the girl", "an athlete"): dropped from a segment's text.
+fn is_subject_noun(word: &str) -> bool {
+    matches!(
+        word,
+        "man"
+            | "woman"
+            | "girl"
+            | "boy"
+            | "child"
+            | "kid"
+            | "person"
+            | "someone"
+            | "athlete"
+            | "dancer"
+            | "player"
+            | "student"
+            | "soldier"
+            | "monk"
+            | "runner"
+            | "referee"
+            | "gymnast"
+            | "hiker"
+            | "fan"
+            | "winner"
+            | "singer"
+            | "model"
+            | "climber"
+            | "bodybuilder"
+            | "cheerleader"
+            | "goalkeeper"
+            | "people"
+            | "guy"
+            | "lady"
+            | "his"
+            | "her"
+            | "old"
+            | "young"
+    )
+}
+
+fn describe_names(postures: &[&NamedPosture]) -> String {
+    let names: Vec<&str> = postures.iter().map(|p| p.name.as_str()).collect();
+    names.join(" and ")
+}
+
+/// Arms-only postures laid into one script (the first one's arms, then the next's where they
+/// do not contradict it).
+fn merge_arms(postures: &[&NamedPosture], notes: &mut Vec<String>) -> Option<PostureScript> {
+    let (first, rest) = postures.split_first()?;
+    let mut script = first.script.clone();
+    for p in rest {
+        let mut constraints = script.constraints.clone();
+        constraints.extend(p.script.constraints.iter().copied());
+        match (PostureScript {
+            name: Some(format!("{} with {}", first.name, p.name)),
+            hold: script.hold.max(p.script.hold),
+            constraints,
+        })
+        .check()
+        {
+            Ok(s) => script = s,
+            Err(_) => notes.push(format!(
+                "{} and {} ask different things of the arms; kept {}",
+                first.name, p.name, first.name
+            )),
+        }
+    }
+    Some(script)
+}
+
+/// How many times a clause asks for its movement: "twice", "three times", or a number just
+/// before it ("five push-ups").
+fn repetitions(words: &[&str], text: &str, action_at: Option<usize>) -> Option<u32> {
+    let said = lexicon::repetitions(words);
+    if said > 1 {
+        return Some(said as u32);
+    }
+    let at = action_at?;
+    let before = text[..at].split(' ').rev().find(|w| !w.is_empty())?;
+    lexicon::number(before).map(|n| n.round().clamp(1.0, 10.0) as u32)
+}
+
+/// The way a movement travels, `[left, forward]`: forward unless the clause says otherwise,
+/// and nowhere when it names no direction.
+fn direction(words: &[&str]) -> [f64; 2] {
+    let has = |w: &[&str]| words.iter().any(|x| w.contains(x));
+    if has(&["forward", "forwards", "ahead", "across"]) {
+        [0.0, 1.0]
+    } else if has(&["backward", "backwards"]) {
+        [0.0, -1.0]
+    } else if has(&["sideways", "aside"]) && has(&["left"]) {
+        [1.0, 0.0]
+    } else if has(&["sideways", "aside"]) && has(&["right"]) {
+        [-1.0, 0.0]
+    } else {
+        [0.0, 0.0]
+    }
+}

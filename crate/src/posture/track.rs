@@ -1,0 +1,452 @@
+//! Posture tracks: the key poses a plan's segment asks for, and how they are laid over the
+//! motion the model generated ([`lay_tracks`]).
+//!
+//! A track on all four body parts is a *posture segment*: its key poses replace the generated
+//! motion over the segment's frames, root included, starting from the pose the motion is in
+//! and ending in the pose the next segment starts with, so segments join without a jump. A
+//! track on some parts is *held* on those parts over the generated motion (a T-pose on the arms
+//! of a walk), eased in and out.
+
+use super::go::{self, KeyPose, Transition};
+use super::script::PostureScript;
+use super::solver::{solve, Angles};
+use crate::geom::{self, Quat, Vec3};
+use crate::posecodes::facing;
+use crate::skeleton::{self, BodyPart, Offsets, Pose};
+use crate::timing::FPS;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+
+/// Most key poses in one track.
+pub const MAX_KEYS: usize = 8;
+/// Most repetitions of a track's keys (squats × 10).
+pub const MAX_REPEAT: u32 = 10;
+/// Longest transition into a key, seconds.
+pub const MAX_TRANSITION_SECONDS: f64 = 5.0;
+/// Transition into a key when the track does not say, seconds.
+pub const DEFAULT_TRANSITION_SECONDS: f64 = 0.8;
+/// Largest turn at one key, degrees (two full spins).
+pub const MAX_TURN_DEG: f64 = 720.0;
+/// Largest travel at one key, metres along each ground axis.
+pub const MAX_TRAVEL_M: f64 = 3.0;
+/// Highest jump, metres the pelvis rises at the top of the flight.
+pub const MAX_JUMP_M: f64 = 1.0;
+/// Time (seconds) a held posture takes to let go of its parts at the end of its range.
+pub const RELEASE_SECONDS: f64 = 0.5;
+
+/// One key pose of a track and how it is reached.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackKey {
+    /// The pose (its `hold` is how long it is held, seconds).
+    pub script: PostureScript,
+    /// Seconds to move into the pose from the previous one (0 to [`MAX_TRANSITION_SECONDS`]).
+    #[serde(default = "default_transition")]
+    pub transition: f64,
+    /// Turn on the spot reached at this key, degrees, + to the left (counter-clockwise seen
+    /// from above); 360 is a full spin.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub turn_deg: f64,
+    /// Ground travel `[left, forward]` in metres, in the facing of the previous key, covered
+    /// while moving into this key (crawling forward, a step).
+    #[serde(default, skip_serializing_if = "is_zero2")]
+    pub travel: [f64; 2],
+    /// A jump into this key: the height in metres the pelvis rises at the top of the flight.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jump_m: Option<f64>,
+}
+
+fn default_transition() -> f64 {
+    DEFAULT_TRANSITION_SECONDS
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+fn is_zero2(v: &[f64; 2]) -> bool {
+    v[0] == 0.0 && v[1] == 0.0
+}
+
+fn one() -> u32 {
+    1
+}
+
+/// The key poses of one plan segment.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "TrackFields")]
+pub struct PostureTrack {
+    /// The body parts that follow the key poses. All four make a posture segment (the key poses
+    /// replace the generated motion, root included); fewer hold the poses on those parts over
+    /// the generated motion.
+    pub parts: Vec<BodyPart>,
+    /// The key poses in order (1 to [`MAX_KEYS`]).
+    pub keys: Vec<TrackKey>,
+    /// How many times the keys are played (1 to [`MAX_REPEAT`]); a repeated track comes back to
+    /// the pose it started from between and after the repetitions (squats × 3).
+    #[serde(default = "one")]
+    pub repeat: u32,
+    /// Whether the track ends back in the pose it started from (a squat goes down and comes
+    /// up; "sits down" stays down).
+    #[serde(default)]
+    pub returns: bool,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrackFields {
+    parts: Vec<BodyPart>,
+    keys: Vec<TrackKey>,
+    #[serde(default = "one")]
+    repeat: u32,
+    #[serde(default)]
+    returns: bool,
+}
+
+impl TryFrom<TrackFields> for PostureTrack {
+    type Error = String;
+
+    fn try_from(f: TrackFields) -> Result<PostureTrack, String> {
+        PostureTrack {
+            parts: f.parts,
+            keys: f.keys,
+            repeat: f.repeat,
+            returns: f.returns,
+        }
+        .checked()
+    }
+}
+
+impl PostureTrack {
+    /// A track of one key pose held on `parts`.
+    pub fn holding(parts: Vec<BodyPart>, script: PostureScript) -> PostureTrack {
+        PostureTrack {
+            parts,
+            keys: vec![TrackKey {
+                script,
+                transition: DEFAULT_TRANSITION_SECONDS,
+                turn_deg: 0.0,
+                travel: [0.0, 0.0],
+                jump_m: None,
+            }],
+            repeat: 1,
+            returns: false,
+        }
+    }
+
+    /// Checks the bounds (parts, number of keys, repetitions, times, turns, travel, jumps) and
+    /// each key's script; messages name the key.
+    pub fn checked(mut self) -> Result<PostureTrack, String> {
+        if self.parts.is_empty() {
+            return Err("a posture track needs at least one body part".into());
+        }
+        self.parts.sort();
+        self.parts.dedup();
+        if self.keys.is_empty() || self.keys.len() > MAX_KEYS {
+            return Err(format!(
+                "a posture track has 1 to {MAX_KEYS} key poses, this one {}",
+                self.keys.len()
+            ));
+        }
+        if !(1..=MAX_REPEAT).contains(&self.repeat) {
+            return Err(format!(
+                "a posture track repeats 1 to {MAX_REPEAT} times, not {}",
+                self.repeat
+            ));
+        }
+        for (i, k) in self.keys.iter_mut().enumerate() {
+            let bounded = |v: f64, lo: f64, hi: f64, what: &str| {
+                if v.is_finite() && (lo..=hi).contains(&v) {
+                    Ok(v)
+                } else {
+                    Err(format!(
+                        "key pose {}: {what} must be from {lo} to {hi}, not {v}",
+                        i + 1
+                    ))
+                }
+            };
+            k.transition = bounded(k.transition, 0.0, MAX_TRANSITION_SECONDS, "transition (s)")?;
+            k.turn_deg = bounded(k.turn_deg, -MAX_TURN_DEG, MAX_TURN_DEG, "turn (degrees)")?;
+            for t in &mut k.travel {
+                *t = bounded(*t, -MAX_TRAVEL_M, MAX_TRAVEL_M, "travel (m)")?;
+            }
+            if let Some(j) = k.jump_m {
+                k.jump_m = Some(bounded(j, 0.0, MAX_JUMP_M, "jump height (m)")?);
+            }
+            k.script = k
+                .script
+                .clone()
+                .check()
+                .map_err(|e| format!("key pose {}: {e}", i + 1))?;
+        }
+        Ok(self)
+    }
+
+    /// Whether the track drives the whole body, root included.
+    pub fn whole_body(&self) -> bool {
+        self.parts.len() == BodyPart::ALL.len()
+    }
+
+    /// Seconds the track takes at its own pace: every transition and hold, times the
+    /// repetitions, plus the way back when it returns.
+    pub fn natural_seconds(&self) -> f64 {
+        let once: f64 = self.keys.iter().map(|k| k.transition + k.script.hold).sum();
+        let back = if self.returns || self.repeat > 1 {
+            self.keys[0].transition
+        } else {
+            0.0
+        };
+        once * self.repeat as f64 + back * self.repeat.max(1) as f64
+    }
+
+    /// The track in words for the plan view ("key 1 (squat, held 0.6 s): the left knee is …").
+    pub fn in_words(&self) -> Vec<String> {
+        self.keys
+            .iter()
+            .enumerate()
+            .map(|(i, k)| {
+                format!(
+                    "key {} ({}, held {:.1} s): {}",
+                    i + 1,
+                    k.script.name.as_deref().unwrap_or("posture"),
+                    k.script.hold,
+                    k.script.in_words()
+                )
+            })
+            .collect()
+    }
+}
+
+/// A track placed on frames of the motion (20 fps).
+#[derive(Clone, Debug)]
+pub struct TrackSpan<'a> {
+    /// The frames the track covers.
+    pub frames: Range<usize>,
+    /// The track.
+    pub track: &'a PostureTrack,
+}
+
+/// Where a pose stands: pelvis on the ground plane and heading (radians, 0 = facing +Z,
+/// + = turned left).
+#[derive(Clone, Copy, Debug)]
+struct Placement {
+    ground: Vec3,
+    heading: f64,
+}
+
+impl Placement {
+    fn of(pose: &Pose) -> Placement {
+        let f = facing(pose);
+        Placement {
+            ground: [pose[0][0], 0.0, pose[0][2]],
+            heading: f[0].atan2(f[2]),
+        }
+    }
+
+    /// `pose` moved from this placement to the origin facing +Z.
+    fn to_local(self, pose: &Pose) -> Pose {
+        let turn = Quat::from_yaw(-self.heading);
+        pose.map(|p| {
+            let d = turn.rotate(geom::sub(p, self.ground));
+            [d[0], p[1], d[2]]
+        })
+    }
+
+    /// `pose` moved from the origin facing +Z to this placement.
+    fn to_world(self, pose: &Pose) -> Pose {
+        let turn = Quat::from_yaw(self.heading);
+        pose.map(|p| {
+            let d = turn.rotate([p[0], 0.0, p[2]]);
+            [d[0] + self.ground[0], p[1], d[2] + self.ground[2]]
+        })
+    }
+}
+
+/// The key poses of a track solved in order (each from the previous one's angles, so a
+/// sequence stays consistent), with the constraints the solver could not meet in words.
+fn solve_keys(track: &PostureTrack) -> (Vec<Pose>, Vec<String>) {
+    let mut previous: Option<Angles> = None;
+    let mut poses = Vec::with_capacity(track.keys.len());
+    let mut notes = Vec::new();
+    for (i, k) in track.keys.iter().enumerate() {
+        let solved = solve(&k.script, previous.as_ref());
+        if !solved.unmet.is_empty() {
+            let missed: Vec<String> = solved.unmet.iter().map(|c| c.to_string()).collect();
+            notes.push(format!(
+                "key pose {} ({}) could not show: {}",
+                i + 1,
+                k.script.name.as_deref().unwrap_or("posture"),
+                missed.join("; ")
+            ));
+        }
+        previous = Some(solved.angles);
+        poses.push(solved.pose);
+    }
+    (poses, notes)
+}
+
+/// The go stage's keys for a track that starts in `start` (a pose at the origin facing +Z),
+/// with transitions and holds scaled so that the track fills `seconds`: spare time lengthens
+/// the holds (or, with none, the transitions), missing time shortens everything.
+fn go_keys(track: &PostureTrack, start: Pose, solved: &[Pose], seconds: f64) -> Vec<KeyPose> {
+    let natural = track.natural_seconds().max(1e-6);
+    let holds: f64 = track.keys.iter().map(|k| k.script.hold).sum::<f64>() * track.repeat as f64;
+    let (hold_scale, move_scale) = if seconds >= natural && holds > 0.0 {
+        (1.0 + (seconds - natural) / holds, 1.0)
+    } else {
+        (seconds / natural, seconds / natural)
+    };
+    let first = KeyPose::new(start, 0.0, 0.0);
+    let mut cycle = vec![first];
+    for (k, pose) in track.keys.iter().zip(solved) {
+        cycle.push(KeyPose {
+            pose: *pose,
+            transition: k.transition * move_scale,
+            hold: k.script.hold * hold_scale,
+            turn_deg: k.turn_deg,
+            travel: k.travel,
+            motion: match k.jump_m {
+                Some(apex_m) => Transition::Flight { apex_m },
+                None => Transition::Ease,
+            },
+        });
+    }
+    if track.returns || track.repeat > 1 {
+        // The way back into the start uses the first key's transition time.
+        cycle[0].transition = track.keys[0].transition * move_scale;
+        go::repeat(&cycle, track.repeat as usize)
+    } else {
+        cycle
+    }
+}
+
+/// Lays posture tracks over a motion (world joints, 20 fps) and returns the new motion with
+/// notes (key poses that could not be met in full, tracks that needed more time than their
+/// frames). Spans are taken in order of their first frame; a whole-body span may change the
+/// motion's length when its key poses need more time than the span has, and later spans move
+/// with it.
+pub fn lay_tracks(base: &[Pose], spans: &[TrackSpan<'_>]) -> (Vec<Pose>, Vec<String>) {
+    let mut out = base.to_vec();
+    let mut notes = Vec::new();
+    let mut spans = spans.to_vec();
+    spans.sort_by_key(|s| s.frames.start);
+    let mut shift: isize = 0;
+    for span in spans {
+        if out.is_empty() {
+            break;
+        }
+        let start = (span.frames.start as isize + shift).clamp(0, out.len() as isize - 1) as usize;
+        let end =
+            ((span.frames.end as isize + shift).max(start as isize + 1) as usize).min(out.len());
+        let (solved, key_notes) = solve_keys(span.track);
+        notes.extend(key_notes);
+        if span.track.whole_body() {
+            let before = out.len();
+            lay_whole_body(&mut out, start, end, span.track, &solved, &mut notes);
+            shift += out.len() as isize - before as isize;
+        } else {
+            lay_on_parts(&mut out, start, end, span.track, &solved);
+        }
+    }
+    (out, notes)
+}
+
+fn lay_whole_body(
+    out: &mut Vec<Pose>,
+    start: usize,
+    end: usize,
+    track: &PostureTrack,
+    solved: &[Pose],
+    notes: &mut Vec<String>,
+) {
+    // Continue from the last frame before the span (the first frame when the span opens the
+    // motion), so the join has no jump.
+    let from = start.saturating_sub(1);
+    let place = Placement::of(&out[from]);
+    let seconds = (end - from) as f64 / FPS;
+    let mut keys = go_keys(track, place.to_local(&out[from]), solved, seconds);
+    let next = (end < out.len()).then(|| out[end]);
+    if let Some(next) = next {
+        // End in the shape the next segment starts with, so it follows without a jump.
+        let shape = Placement::of(&next).to_local(&next);
+        keys.push(KeyPose::new(shape, DEFAULT_TRANSITION_SECONDS, 0.0));
+    }
+    let local = go::go(&keys);
+    let made: Vec<Pose> = local.iter().map(|p| place.to_world(p)).collect();
+    let wanted = end - from;
+    if made.len() > wanted + (FPS * 0.25) as usize {
+        notes.push(format!(
+            "the key poses needed {:.1} s, {:.1} s more than their segment",
+            (made.len() - 1) as f64 / FPS,
+            (made.len() - 1 - wanted) as f64 / FPS
+        ));
+    }
+    let mut rest: Vec<Pose> = out.split_off(end);
+    out.truncate(from + 1);
+    out.extend_from_slice(&made[1.min(made.len())..]);
+    if let (Some(next), Some(last)) = (next, out.last().copied()) {
+        // The rest of the motion moves rigidly so that it continues where the key poses ended.
+        let (a, b) = (Placement::of(&next), Placement::of(&last));
+        for p in rest.iter_mut() {
+            *p = b.to_world(&a.to_local(p));
+        }
+        // The end key already is the next frame's shape; skip the duplicate.
+        if !rest.is_empty() {
+            rest.remove(0);
+        }
+    }
+    out.extend(rest);
+}
+
+/// Blends the parts' bones from the generated motion into the track's key poses and back.
+fn lay_on_parts(out: &mut [Pose], start: usize, end: usize, track: &PostureTrack, solved: &[Pose]) {
+    let frames = end - start;
+    if frames < 2 {
+        return;
+    }
+    let place = Placement::of(&out[start]);
+    let keys = go_keys(
+        track,
+        place.to_local(&out[start]),
+        solved,
+        frames as f64 / FPS,
+    );
+    let local = go::go(&keys);
+    let held_to_end = end >= out.len();
+    let ease_in = (track.keys[0].transition * FPS).max(1.0);
+    let ease_out = (RELEASE_SECONDS * FPS).min(frames as f64 / 4.0).max(1.0);
+    let bones: Vec<usize> = track
+        .parts
+        .iter()
+        .flat_map(|p| p.limb_joints().iter().copied())
+        .collect();
+    let offsets = Offsets::reference();
+    for f in 0..frames {
+        let t = f as f64;
+        let weight = if held_to_end {
+            geom::ease(t / ease_in)
+        } else {
+            geom::ease(t / ease_in).min(geom::ease((frames as f64 - 1.0 - t) / ease_out))
+        };
+        if weight <= 0.0 {
+            continue;
+        }
+        let frame = start + f;
+        // Placed where the generated body is now, so held arms turn with a body that turns.
+        let target = Placement::of(&out[frame]).to_world(&local[f.min(local.len() - 1)]);
+        let mut rots = skeleton::inverse_kinematics(&[out[frame]], false)[0];
+        let goal = skeleton::inverse_kinematics(&[target], false)[0];
+        for &j in &bones {
+            rots[j] = rots[j].slerp(goal[j], weight);
+        }
+        let mut pose = skeleton::forward_kinematics(&[rots], &offsets, &[out[frame][0]])[0];
+        // A leg laid over a motion must not push the body through the floor.
+        let lowest = pose.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+        if lowest < 0.0 {
+            for p in pose.iter_mut() {
+                p[1] -= lowest;
+            }
+        }
+        out[frame] = pose;
+    }
+}
