@@ -379,7 +379,12 @@ pub fn lay_postures(
         .segments
         .iter()
         .zip(segment_ranges(plan, tokens))
-        .filter_map(|(s, frames)| s.postures.as_ref().map(|track| TrackSpan { frames, track }))
+        .filter_map(|(s, frames)| {
+            s.postures.as_ref().map(|track| TrackSpan {
+                frames: track.frames_within(frames),
+                track,
+            })
+        })
         .collect();
     if spans.is_empty() || features.is_empty() {
         return (features.to_vec(), Vec::new());

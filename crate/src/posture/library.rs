@@ -86,6 +86,7 @@ impl Action {
             keys,
             repeat: count.unwrap_or(1).clamp(1, MAX_REPEAT),
             returns: self.returns,
+            within: None,
         }
     }
 }

@@ -90,6 +90,10 @@ pub struct PostureTrack {
     /// up; "sits down" stays down).
     #[serde(default)]
     pub returns: bool,
+    /// The time range the track covers, seconds from the start of its segment `[from, to]`;
+    /// the whole segment when absent (a posture chosen in the page for part of a segment).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub within: Option<[f64; 2]>,
 }
 
 #[derive(Deserialize)]
@@ -101,6 +105,8 @@ struct TrackFields {
     repeat: u32,
     #[serde(default)]
     returns: bool,
+    #[serde(default)]
+    within: Option<[f64; 2]>,
 }
 
 impl TryFrom<TrackFields> for PostureTrack {
@@ -112,6 +118,7 @@ impl TryFrom<TrackFields> for PostureTrack {
             keys: f.keys,
             repeat: f.repeat,
             returns: f.returns,
+            within: f.within,
         }
         .checked()
     }
@@ -131,6 +138,7 @@ impl PostureTrack {
             }],
             repeat: 1,
             returns: false,
+            within: None,
         }
     }
 
@@ -147,6 +155,14 @@ impl PostureTrack {
                 "a posture track has 1 to {MAX_KEYS} key poses, this one {}",
                 self.keys.len()
             ));
+        }
+        if let Some([from, to]) = self.within {
+            if !(from.is_finite() && to.is_finite() && 0.0 <= from && from < to) {
+                return Err(format!(
+                    "a posture track's time range must be two times in seconds, the first \
+                     before the second, not [{from}, {to}]"
+                ));
+            }
         }
         if !(1..=MAX_REPEAT).contains(&self.repeat) {
             return Err(format!(
@@ -180,6 +196,17 @@ impl PostureTrack {
                 .map_err(|e| format!("key pose {}: {e}", i + 1))?;
         }
         Ok(self)
+    }
+
+    /// The frames (20 fps) the track covers within a segment that covers `segment`.
+    pub fn frames_within(&self, segment: Range<usize>) -> Range<usize> {
+        match self.within {
+            Some([from, to]) => {
+                let at = |s: f64| (segment.start + (s * FPS).round() as usize).min(segment.end);
+                at(from)..at(to).max(at(from))
+            }
+            None => segment,
+        }
     }
 
     /// Whether the track drives the whole body, root included.
