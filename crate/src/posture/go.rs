@@ -171,14 +171,21 @@ impl KeyPose {
 /// or jumped), so the motion may be longer than the keys' times add up to. An empty list
 /// gives an empty motion; the same keys always give the same frames.
 pub fn go(keys: &[KeyPose]) -> Vec<Pose> {
+    go_timed(keys).0
+}
+
+/// [`go`], with the time (seconds from the start) at which each key is reached and its hold
+/// begins: transitions the go stage lengthened show here, so a key's frames can be found.
+pub fn go_timed(keys: &[KeyPose]) -> (Vec<Pose>, Vec<f64>) {
     if keys.is_empty() {
-        return Vec::new();
+        return (Vec::new(), Vec::new());
     }
     let timeline = Timeline::new(keys);
     let frames = (timeline.total * FPS - 1e-9).ceil().max(0.0) as usize + 1;
-    (0..frames)
+    let poses = (0..frames)
         .map(|f| timeline.frame_at((f as f64 / FPS).min(timeline.total)))
-        .collect()
+        .collect();
+    (poses, timeline.keys.iter().map(|k| k.reached).collect())
 }
 
 /// A cycle played `times` times and closed on its first key: `keys` repeated, then

@@ -139,6 +139,40 @@ impl Constraint {
         }
     }
 
+    /// The skeleton joints the constraint reads; lean, twist and level read the trunk and
+    /// legs (pelvis, hips, neck, shoulders, knees).
+    pub fn joints(&self) -> Vec<usize> {
+        match *self {
+            Constraint::Bend { joint, .. } => joint.joints().to_vec(),
+            Constraint::Distance { a, b, .. } | Constraint::Relation { a, b, .. } => {
+                vec![a.joint(), b.joint()]
+            }
+            Constraint::Orientation { limb, .. } => {
+                let (a, b) = limb.joints();
+                vec![a, b]
+            }
+            Constraint::Contact { point, .. } => match point {
+                Support::LeftFoot => vec![joint::L_ANKLE, joint::L_FOOT],
+                Support::RightFoot => vec![joint::R_ANKLE, joint::R_FOOT],
+                Support::LeftKnee => vec![joint::L_KNEE],
+                Support::RightKnee => vec![joint::R_KNEE],
+                Support::LeftHand => vec![joint::L_WRIST],
+                Support::RightHand => vec![joint::R_WRIST],
+                Support::Pelvis => vec![joint::PELVIS],
+            },
+            Constraint::Lean { .. } | Constraint::Twist { .. } | Constraint::Level { .. } => vec![
+                joint::PELVIS,
+                joint::L_HIP,
+                joint::R_HIP,
+                joint::NECK,
+                joint::L_SHOULDER,
+                joint::R_SHOULDER,
+                joint::L_KNEE,
+                joint::R_KNEE,
+            ],
+        }
+    }
+
     /// What the constraint is about, so that two constraints on the same subject can be
     /// compared: the same subject with different values is a contradiction.
     fn subject(&self) -> Subject {

@@ -291,7 +291,7 @@ impl Placement {
 
 /// The key poses of a track solved in order (each from the previous one's angles, so a
 /// sequence stays consistent), with the constraints the solver could not meet in words.
-fn solve_keys(track: &PostureTrack) -> (Vec<Pose>, Vec<String>) {
+fn solve_keys(track: &PostureTrack, chained: bool) -> (Vec<Pose>, Vec<String>) {
     let mut previous: Option<Angles> = None;
     let mut poses = Vec::with_capacity(track.keys.len());
     let mut notes = Vec::new();
@@ -306,10 +306,65 @@ fn solve_keys(track: &PostureTrack) -> (Vec<Pose>, Vec<String>) {
                 missed.join("; ")
             ));
         }
-        previous = Some(solved.angles);
+        if chained {
+            previous = Some(solved.angles);
+        }
         poses.push(solved.pose);
     }
     (poses, notes)
+}
+
+/// Frames (counted from the first key) at the middle of each key's hold, with the index of the
+/// track key it is, from the times the go stage reached the keys.
+fn key_frames(track: &PostureTrack, keys: &[KeyPose], reached: &[f64]) -> Vec<(usize, usize)> {
+    let cycle = track.keys.len() + 1;
+    keys.iter()
+        .zip(reached)
+        .enumerate()
+        .filter_map(|(j, (k, t))| {
+            let c = j % cycle;
+            (j > 0 && c > 0 && c <= track.keys.len())
+                .then(|| (((t + k.hold / 2.0) * FPS).round() as usize, c - 1))
+        })
+        .collect()
+}
+
+/// What the review of a laid track found: per key pose checked, its frame and the
+/// constraints the describer does not read there.
+struct KeyReview {
+    misses: Vec<(usize, usize, Vec<super::script::Constraint>)>,
+}
+
+impl KeyReview {
+    fn count(&self) -> usize {
+        self.misses.iter().map(|(_, _, m)| m.len()).sum()
+    }
+}
+
+fn review_keys(motion: &[Pose], track: &PostureTrack, checks: &[(usize, usize)]) -> KeyReview {
+    let floor = crate::posecodes::floor_height(motion);
+    // Held on some parts, a key pose's constraints on the rest of the body (its level, the
+    // legs under held arms) describe the generated motion, not the posture.
+    let held: Vec<usize> = track
+        .parts
+        .iter()
+        .flat_map(|p| p.limb_joints().iter().copied())
+        .chain(track.whole_body().then_some(0..22).into_iter().flatten())
+        .collect();
+    let misses = checks
+        .iter()
+        .filter_map(|&(frame, key)| {
+            let pose = motion.get(frame)?;
+            let unmet: Vec<_> = track.keys[key]
+                .script
+                .unmet(pose, floor)
+                .into_iter()
+                .filter(|c| c.joints().iter().all(|j| held.contains(j)))
+                .collect();
+            (!unmet.is_empty()).then_some((frame, key, unmet))
+        })
+        .collect();
+    KeyReview { misses }
 }
 
 /// The go stage's keys for a track that starts in `start` (a pose at the origin facing +Z),
@@ -365,15 +420,53 @@ pub fn lay_tracks(base: &[Pose], spans: &[TrackSpan<'_>]) -> (Vec<Pose>, Vec<Str
         let start = (span.frames.start as isize + shift).clamp(0, out.len() as isize - 1) as usize;
         let end =
             ((span.frames.end as isize + shift).max(start as isize + 1) as usize).min(out.len());
-        let (solved, key_notes) = solve_keys(span.track);
-        notes.extend(key_notes);
-        if span.track.whole_body() {
-            let before = out.len();
-            lay_whole_body(&mut out, start, end, span.track, &solved, &mut notes);
-            shift += out.len() as isize - before as isize;
-        } else {
-            lay_on_parts(&mut out, start, end, span.track, &solved);
+        let lay = |chained: bool| {
+            let (solved, key_notes) = solve_keys(span.track, chained);
+            let mut laid = out.clone();
+            let mut lay_notes = key_notes;
+            let checks = if span.track.whole_body() {
+                lay_whole_body(&mut laid, start, end, span.track, &solved, &mut lay_notes)
+            } else {
+                lay_on_parts(&mut laid, start, end, span.track, &solved)
+            };
+            let review = review_keys(&laid, span.track, &checks);
+            (laid, lay_notes, review)
+        };
+        let (mut laid, mut lay_notes, mut review) = lay(true);
+        if review.count() > 0 {
+            // The reviewer's correction: key poses solved each on its own rather than from the
+            // one before, laid again, kept if the describer then reads more of them back.
+            let before = review.count();
+            let (again, again_notes, again_review) = lay(false);
+            if again_review.count() < before {
+                lay_notes = again_notes;
+                lay_notes.push(format!(
+                    "review: {} constraint(s) of the key poses were not shown; solving each key \
+                     pose on its own corrected {}",
+                    before,
+                    before - again_review.count()
+                ));
+                laid = again;
+                review = again_review;
+            }
         }
+        for (frame, key, unmet) in &review.misses {
+            let missed: Vec<String> = unmet.iter().map(|c| c.to_string()).collect();
+            lay_notes.push(format!(
+                "review: at {:.1} s, key pose {} ({}) does not show: {}",
+                *frame as f64 / FPS,
+                key + 1,
+                span.track.keys[*key]
+                    .script
+                    .name
+                    .as_deref()
+                    .unwrap_or("posture"),
+                missed.join("; ")
+            ));
+        }
+        shift += laid.len() as isize - out.len() as isize;
+        out = laid;
+        notes.extend(lay_notes);
     }
     (out, notes)
 }
@@ -385,7 +478,7 @@ fn lay_whole_body(
     track: &PostureTrack,
     solved: &[Pose],
     notes: &mut Vec<String>,
-) {
+) -> Vec<(usize, usize)> {
     // Continue from the last frame before the span (the first frame when the span opens the
     // motion), so the join has no jump.
     let from = start.saturating_sub(1);
@@ -398,7 +491,11 @@ fn lay_whole_body(
         let shape = Placement::of(&next).to_local(&next);
         keys.push(KeyPose::new(shape, DEFAULT_TRANSITION_SECONDS, 0.0));
     }
-    let local = go::go(&keys);
+    let (local, reached) = go::go_timed(&keys);
+    let checks: Vec<(usize, usize)> = key_frames(track, &keys, &reached)
+        .into_iter()
+        .map(|(f, k)| (from + f, k))
+        .collect();
     let made: Vec<Pose> = local.iter().map(|p| place.to_world(p)).collect();
     let wanted = end - from;
     if made.len() > wanted + (FPS * 0.25) as usize {
@@ -423,13 +520,20 @@ fn lay_whole_body(
         }
     }
     out.extend(rest);
+    checks
 }
 
 /// Blends the parts' bones from the generated motion into the track's key poses and back.
-fn lay_on_parts(out: &mut [Pose], start: usize, end: usize, track: &PostureTrack, solved: &[Pose]) {
+fn lay_on_parts(
+    out: &mut [Pose],
+    start: usize,
+    end: usize,
+    track: &PostureTrack,
+    solved: &[Pose],
+) -> Vec<(usize, usize)> {
     let frames = end - start;
     if frames < 2 {
-        return;
+        return Vec::new();
     }
     let place = Placement::of(&out[start]);
     let keys = go_keys(
@@ -438,7 +542,12 @@ fn lay_on_parts(out: &mut [Pose], start: usize, end: usize, track: &PostureTrack
         solved,
         frames as f64 / FPS,
     );
-    let local = go::go(&keys);
+    let (local, reached) = go::go_timed(&keys);
+    let checks: Vec<(usize, usize)> = key_frames(track, &keys, &reached)
+        .into_iter()
+        .filter(|(f, _)| *f < frames)
+        .map(|(f, k)| (start + f, k))
+        .collect();
     let held_to_end = end >= out.len();
     let ease_in = (track.keys[0].transition * FPS).max(1.0);
     let ease_out = (RELEASE_SECONDS * FPS).min(frames as f64 / 4.0).max(1.0);
@@ -476,4 +585,5 @@ fn lay_on_parts(out: &mut [Pose], start: usize, end: usize, track: &PostureTrack
         }
         out[frame] = pose;
     }
+    checks
 }

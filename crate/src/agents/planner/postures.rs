@@ -219,13 +219,14 @@ pub fn hold_segment(words: &[&str], previous: &Segment) -> Option<Segment> {
     })
 }
 
-/// Whether a clause names a posture or movement of the library that the model does not make
-/// itself (so that "kneels and raises the right hand" stays one movement).
+/// Whether a clause names a whole-body posture of the library (a state one stays in, not a
+/// movement like standing up), so that "kneels and raises the right hand" stays one movement
+/// while "gets up and waves" is two.
 pub fn names_posture(words: &[&str]) -> bool {
     Library::builtin()
         .mentions(&words.join(" "))
         .iter()
-        .any(|(_, n)| !matches!(n, Named::Posture(p) if arms_only(p)))
+        .any(|(_, n)| matches!(n, Named::Posture(p) if !arms_only(p)))
 }
 
 /// Which part of the body a constraint is about, to merge two postures (a squat's legs with a
@@ -368,7 +369,19 @@ pub fn plan_clause(
     let (arm_postures, body_postures): (Vec<&NamedPosture>, Vec<&NamedPosture>) =
         postures.iter().partition(|p| arms_only(p));
     let locomotion = model.is_some_and(|(base, _)| base.is_locomotion());
+    // A gesture word inside a named posture ("points up with both hands", "one arm forward
+    // and up") is the posture's, not a gesture of its own.
+    let mut at = 0;
+    let gesture_outside = words.iter().enumerate().any(|(i, w)| {
+        let start = at;
+        at += w.len() + 1;
+        let next = &words[i + 1..];
+        let prev: Vec<&str> = words[..i].iter().rev().copied().collect();
+        lexicon::action_word(w, next, &prev).is_some_and(|a| a.is_gesture())
+            && !mentions.iter().any(|(r, _)| r.contains(&start))
+    });
     let gestures: Vec<Action> = model
+        .filter(|_| gesture_outside)
         .map(|(base, gestures)| {
             std::iter::once(base)
                 .filter(|b| b.is_gesture())
