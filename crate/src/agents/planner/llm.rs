@@ -11,6 +11,9 @@ use crate::agents::llm::{
 };
 use crate::dataset::Vocabulary;
 use crate::plan::{clamp_seconds, clean_text, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS};
+use crate::posture::script::PostureScript;
+use crate::posture::track::{PostureTrack, TrackKey, DEFAULT_TRANSITION_SECONDS};
+use crate::skeleton::BodyPart;
 use crate::trajectory::{CurveSpec, Shape, Trajectory};
 use serde::Deserialize;
 use serde_json::{json, Value};
@@ -248,7 +251,14 @@ struct DecomposeReply {
     left_leg: Option<String>,
     right_leg: Option<String>,
     trajectory: Option<Value>,
+    /// Key poses for what the motion model does not know (PRO-Motion's planner): posture
+    /// scripts, checked like any other.
+    #[serde(default)]
+    key_poses: Option<Vec<Value>>,
 }
+
+/// Most key poses the LLM may write for one segment.
+const MAX_LLM_KEY_POSES: usize = 4;
 
 impl Schema for DecomposeReply {
     fn schema() -> Value {
@@ -258,15 +268,63 @@ impl Schema for DecomposeReply {
             "properties": {
                 "base": {"type": "string", "maxLength": 300},
                 "left_arm": part, "right_arm": part, "left_leg": part, "right_leg": part,
-                "trajectory": trajectory_schema()
+                "trajectory": trajectory_schema(),
+                "key_poses": {
+                    "type": ["array", "null"],
+                    "maxItems": MAX_LLM_KEY_POSES,
+                    "items": crate::posture::script::schema()
+                }
             },
             "required": ["base", "left_arm", "right_arm", "left_leg", "right_leg", "trajectory"],
             "additionalProperties": false
         })
     }
+
+    fn check(&self) -> Result<(), String> {
+        self.key_pose_track().map(|_| ())
+    }
 }
 
 impl DecomposeReply {
+    /// The key poses as a whole-body posture track: each script parsed and checked (errors
+    /// name the key pose and the constraint, so the retry can fix them).
+    fn key_pose_track(&self) -> Result<Option<PostureTrack>, String> {
+        match &self.key_poses {
+            None => Ok(None),
+            Some(list) if list.is_empty() => Ok(None),
+            Some(list) if list.len() > MAX_LLM_KEY_POSES => Err(format!(
+                "key_poses: at most {MAX_LLM_KEY_POSES} key poses, got {}",
+                list.len()
+            )),
+            Some(list) => {
+                let keys = list
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| {
+                        PostureScript::from_value(v.clone())
+                            .map(|script| TrackKey {
+                                script,
+                                transition: DEFAULT_TRANSITION_SECONDS,
+                                turn_deg: 0.0,
+                                travel: [0.0, 0.0],
+                                jump_m: None,
+                            })
+                            .map_err(|e| format!("key_poses[{i}]: {e}"))
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                let track = PostureTrack {
+                    parts: BodyPart::ALL.to_vec(),
+                    keys,
+                    repeat: 1,
+                    returns: false,
+                    within: None,
+                }
+                .checked()
+                .map_err(|e| format!("key_poses: {e}"))?;
+                Ok(Some(track))
+            }
+        }
+    }
     fn validate(&self, text: &str, seconds: f64) -> Result<Segment, String> {
         let part = |p: &Option<String>, name: &str| -> Result<Option<String>, String> {
             match p.as_deref().map(str::trim) {
@@ -283,6 +341,7 @@ impl DecomposeReply {
                 Some(trajectory_from_reply(v.clone()).map_err(|e| format!("trajectory: {e}"))?)
             }
         };
+        let postures = self.key_pose_track()?;
         Ok(Segment {
             text: text.to_string(),
             seconds,
@@ -294,9 +353,43 @@ impl DecomposeReply {
                 right_leg: part(&self.right_leg, "right_leg")?,
             },
             trajectory,
-            postures: None,
+            postures,
         })
     }
+}
+
+/// The posture-script vocabulary in a few lines for the LLM, written from the schema so that
+/// it always lists the words the parser accepts.
+fn posture_vocabulary() -> String {
+    let schema = crate::posture::script::schema();
+    let kinds = schema["properties"]["constraints"]["items"]["oneOf"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    kinds
+        .iter()
+        .map(|k| {
+            let props = k["properties"].as_object().cloned().unwrap_or_default();
+            let fields: Vec<String> = props
+                .iter()
+                .map(|(name, spec)| {
+                    let words = match (&spec["const"], spec["enum"].as_array(), &spec["type"]) {
+                        (Value::String(c), _, _) => format!("\"{c}\""),
+                        (_, Some(list), _) => list
+                            .iter()
+                            .filter_map(Value::as_str)
+                            .collect::<Vec<_>>()
+                            .join("|"),
+                        (_, _, Value::String(t)) => t.clone(),
+                        _ => "?".into(),
+                    };
+                    format!("\"{name}\": {words}")
+                })
+                .collect();
+            format!("- {{{}}}", fields.join(", "))
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// The built-in shapes by their stable names ("circle_right" is clockwise).
@@ -443,9 +536,15 @@ fn decompose_messages(context: &str, segment: &str) -> Vec<Message> {
              {{\"shape\": NAME}} with NAME one of {shapes}, or a curve {{\"x\": EXPR, \"z\": \
              EXPR, \"t0\": NUMBER, \"t1\": NUMBER}} on the ground (z is forward, x is the \
              person's left) where EXPR is arithmetic in t with + - * / ^, sin, cos, tan, abs, \
-             sqrt, exp, log, min, max, pi and if(cond, a, b). Reply in JSON with exactly these \
-             six keys.",
-            shapes = shape_names().join(", ")
+             sqrt, exp, log, min, max, pi and if(cond, a, b). Finally \"key_poses\": null, \
+             unless the segment asks for a pose or a movement the model does not make (a \
+             T-pose, a squat, kneeling, sitting or lying on the floor, a dab, a superhero \
+             landing); then a list of 1 to {max} key poses in time order, each {{\"name\": \
+             TEXT, \"hold\": SECONDS, \"constraints\": [...]}} with constraints from this \
+             closed vocabulary:\n{vocabulary}\nReply in JSON with exactly these seven keys.",
+            shapes = shape_names().join(", "),
+            max = MAX_LLM_KEY_POSES,
+            vocabulary = posture_vocabulary()
         )),
         Message::user(segment.to_string()),
     ]

@@ -217,3 +217,30 @@ fn a_valid_curve_from_the_llm_is_kept_as_data() {
     let t = plan.segments[0].trajectory.as_ref().expect("a path");
     t.validate().unwrap();
 }
+
+#[test]
+fn key_poses_from_the_llm_are_checked_and_a_bad_one_is_retried_with_its_error() {
+    let with_poses = |constraint: &str| {
+        ScriptedReply::completion(&format!(
+            r#"{{"base": "a person stands still", "left_arm": null, "right_arm": null, "left_leg": null, "right_leg": null, "trajectory": null, "key_poses": [{{"name": "T-pose", "hold": 1.0, "constraints": [{{"kind": "level", "is": "standing"}}, {constraint}]}}]}}"#
+        ))
+    };
+    let server = ScriptServer::start([
+        good("rewrite"),
+        good("segment"),
+        with_poses(r#"{"kind": "bend", "joint": "left_elbow", "is": "bent"}"#),
+        with_poses(r#"{"kind": "orientation", "limb": "left_upper_arm", "is": "horizontal"}"#),
+    ])
+    .unwrap();
+    let (plan, _) = run(&server);
+    assert!(plan.notes.is_empty(), "{:?}", plan.notes);
+    let track = plan.segments[0].postures.as_ref().expect("a posture track");
+    assert!(track.whole_body());
+    assert_eq!(track.keys[0].script.name.as_deref(), Some("T-pose"));
+    let retry = server.requests()[3].json();
+    let last = retry["messages"].as_array().unwrap().last().unwrap()["content"].to_string();
+    assert!(
+        last.contains("key_poses[0]") && last.contains("bent"),
+        "the retry names the wrong constraint: {last}"
+    );
+}
