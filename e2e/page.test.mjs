@@ -4,8 +4,11 @@
 // three-segment prompt whose link rebuilds it too, and take the screenshots under docs/. A second
 // test runs SPAM on the browser's WebGPU (here SwiftShader, a software adapter, which the page
 // uses only when asked with ?backend=webgpu). A third pastes share links into a tab that already
-// shows the page (only the fragment changes: hashchange, no reload). A fourth plans through a
-// real local LLM server from the page (fetch from the page's worker, CORS), when
+// shows the page (only the fragment changes: hashchange, no reload). A fourth generates a
+// posture prompt (key poses the motion model does not know), checks its key poses in the plan
+// view and on the timeline, rebuilds it from its link, and holds a named posture from the
+// searchable list on the arms (undo, and a link that rebuilds that too). A fifth plans through
+// a real local LLM server from the page (fetch from the page's worker, CORS), when
 // COMA_LOCAL_LLM names one (scripts/test.sh starts it with scripts/llm_server.sh).
 //
 // Needs: the built page in DIST (default ../dist), the coma binary in COMA (serves the page and
@@ -391,6 +394,119 @@ test("a share link pasted into a tab that already shows the page opens there", {
 
     assert.deepEqual(opened.problems, [], "errors in the browser console");
     assert.deepEqual(opened.stats.outside, [], "the page sent something out");
+  } finally {
+    await browser.close();
+    await stop(server);
+  }
+});
+
+test("a posture prompt shows its key poses, and its share link rebuilds the same motion", { timeout: 30 * 60_000 }, async () => {
+  const server = serve();
+  const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
+  try {
+    await waitForServer();
+    const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+    const opened = await open(context, BASE);
+    const { page } = opened;
+    await modelLoaded(page);
+
+    // No LLM: the built-in planner makes the squat in a T-pose a posture segment.
+    await page.fill("#prompt", "A person squats while striking a T-pose, then walks forward");
+    await page.fill("#seconds", "");
+    await page.locator("#seconds").dispatchEvent("change");
+    await page.selectOption("#rounds", "0");
+    await page.fill("#seed", "0");
+    await page.locator("#seed").dispatchEvent("change");
+    let started = Date.now();
+    await page.click("#generate");
+    await page.waitForFunction(() => document.querySelector(".viewer")?.dataset.jointsHash
+      && document.querySelectorAll(".segments:not(.preview) .segment").length > 0
+      && !document.querySelector("#generate").disabled, null, { timeout: LOAD_TIMEOUT });
+    const hash = await jointsHash(page);
+    const frames = Number(await page.locator(".viewer").getAttribute("data-frames"));
+    console.log(`posture prompt: ${frames} frames in ${((Date.now() - started) / 1000).toFixed(1)} s in the page (${await page.locator("#status").textContent()})`);
+    assert.ok(await page.locator(".segment").count() >= 2, "a posture segment, then the walk");
+    // The plan view shows each key pose's script in words, the timeline marks where it is reached.
+    const words = await page.locator(".plan .posture-key").allTextContents();
+    console.log(`key poses: ${words.join(" | ")}`);
+    assert.ok(words.length > 0 && words.every((w) => /^key \d+ \(/.test(w)), words.join(" | "));
+    assert.ok(words.some((w) => /t.pose/i.test(w)) && words.some((w) => /knee/.test(w)), words.join(" | "));
+    assert.match(await page.locator(".plan .postures").first().textContent(), /whole body/);
+    const marks = await page.locator(".segments .key-pose").evaluateAll((ms) => ms.map((m) => m.title));
+    assert.ok(marks.length > 0 && marks.some((t) => /t.pose/i.test(t)), marks.join(" | "));
+
+    // The share link rebuilds the same joints and the same key poses in a fresh page.
+    await page.click("#share");
+    const link = await page.locator("#share-link").inputValue();
+    assert.match(link, /#m=/);
+    const fresh = await open(await browser.newContext({ viewport: { width: 1280, height: 800 } }), link);
+    started = Date.now();
+    await shows(fresh.page, hash);
+    console.log(`the posture link rebuilt the same joints in ${((Date.now() - started) / 1000).toFixed(1)} s (from load: the model loads first)`);
+    assert.deepEqual(await fresh.page.locator(".plan .posture-key").allTextContents(), words, "the link keeps the key poses");
+
+    // A named posture from the searchable list, held on the arms over part of the walk: a new
+    // take (undo goes back), with a link that rebuilds it.
+    const last = page.locator(".segments .segment").last();
+    const [from, to] = [Number(await last.getAttribute("data-from")), Number(await last.getAttribute("data-to"))];
+    await page.click("#postures-summary");
+    await page.fill("#posture-search", "t pose");
+    const choice = page.locator('.posture-choice[data-name="T-pose"]');
+    await choice.click();
+    assert.equal(await choice.getAttribute("aria-pressed"), "true");
+    await page.fill("#posture-search", "no such posture at all");
+    assert.equal(await page.locator(".posture-choice").count(), 0);
+    assert.match(await page.locator("#posture-list").textContent(), /No posture/);
+    await page.fill("#posture-search", "");
+    assert.ok(await page.locator(".posture-choice").count() >= 10, "the whole library is listed");
+    const fromS = (from / 20 + 0.5).toFixed(1);
+    const toS = (to / 20 - 0.2).toFixed(1);
+    await page.fill("#range-from", fromS);
+    await page.locator("#range-from").dispatchEvent("change");
+    await page.fill("#range-to", toS);
+    await page.locator("#range-to").dispatchEvent("change");
+    for (const part of ["left arm", "right arm"]) await page.check(`input[data-part="${part}"]`);
+    started = Date.now();
+    await page.click("#apply-posture");
+    await page.waitForFunction((h) => {
+      const v = document.querySelector(".viewer")?.dataset.jointsHash;
+      return v && v !== h && !document.querySelector("#generate").disabled;
+    }, hash, { timeout: LOAD_TIMEOUT });
+    const held = await jointsHash(page);
+    const status = await page.locator("#status").textContent();
+    console.log(`T-pose held on the arms of the walk in ${((Date.now() - started) / 1000).toFixed(1)} s: ${status}`);
+    assert.match(status, new RegExp(`^Done in .*: T-pose held on the left arm, right arm from ${fromS} to ${toS} s`));
+    const walkWords = await page.locator(".plan .plan-segment").last().locator(".posture-key").allTextContents();
+    assert.ok(walkWords.length === 1 && /^key 1 \(T-pose/.test(walkWords[0]), walkWords.join(" | "));
+    assert.match(await page.locator(".plan .plan-segment").last().locator(".postures").textContent(), /held on the left arm, right arm/);
+    const heldMarks = await page.locator(".segments .key-pose").count();
+    assert.equal(heldMarks, marks.length + 1, "one more key pose on the timeline");
+    await page.locator(".timeline").screenshot({ path: join(SHOTS, "page-postures-timeline.png") });
+    await page.click("#undo");
+    await shows(page, hash);
+    assert.equal(await page.locator(".segments .key-pose").count(), marks.length);
+    await page.click("#redo");
+    await shows(page, held);
+    await page.click("#share");
+    const heldLink = await page.locator("#share-link").inputValue();
+    const again = await open(await browser.newContext({ viewport: { width: 1280, height: 800 } }), heldLink);
+    await shows(again.page, held);
+    assert.deepEqual(await again.page.locator(".plan .posture-key").allTextContents(),
+      await page.locator(".plan .posture-key").allTextContents(), "the link keeps the held posture");
+
+    // A range past the end of the motion: a message, and the take stays.
+    await page.fill("#range-from", "999");
+    await page.locator("#range-from").dispatchEvent("change");
+    await page.fill("#range-to", "1000");
+    await page.locator("#range-to").dispatchEvent("change");
+    await page.click("#apply-posture");
+    assert.match(await page.locator("#status").textContent(), /after the motion ends/);
+    assert.equal(await jointsHash(page), held);
+
+    for (const p of [opened, fresh, again]) {
+      assert.deepEqual(p.problems, [], "errors in the browser console");
+      assert.deepEqual(p.stats.outside, [], "the page sent something out");
+    }
   } finally {
     await browser.close();
     await stop(server);

@@ -8,13 +8,16 @@
 #   scripts/blender_bvh_check.sh motion.npy|.bvh      # any motion file `coma convert` reads
 #   scripts/blender_bvh_check.sh generate "a person waves the left hand" --seed 2 --seconds 5
 #   scripts/blender_bvh_check.sh run "a person walks forward then waves the right hand" --seed 1
-#   scripts/blender_bvh_check.sh posture …            # any `coma` command that takes --out
+#   scripts/blender_bvh_check.sh run "A person squats twice" --seed 1   # key postures
+#   scripts/blender_bvh_check.sh /tmp/lib/jumping-jacks--movement-.npy # a library movement
 #
-# With a command, the engine's motion is written with `--out m.npy` (HumanML3D features, as
-# `coma generate`/`coma run` export them) and both files are converted from it, so the check
-# covers the features export too. A posture motion is checked the same way, with the posture
-# command's own arguments, once it writes `--out` (or from the file it wrote). COMA=path runs
-# another build of coma (e.g. an older one, to compare).
+# With a command (any `coma` command that writes its motion with `--out FILE`), the engine's
+# motion is written with `--out m.npy` (HumanML3D features, as `coma generate`/`coma run`
+# export them) and both files are converted from it, so the check covers the features export
+# too. Key postures: `run` with a prompt the planner plans with postures, or a file that
+# `coma posture motions --out /tmp/lib` wrote (joints of each named posture and movement, as
+# the engine returns them). COMA=path runs another build of coma (e.g. an older one, to
+# compare).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ -n "${COMA:-}" ]; then

@@ -45,6 +45,9 @@ pub enum Pending {
     Edit(Edit),
     /// A take rebuilt from a share link.
     Link(share::SharedMotion),
+    /// The current take's tokens decoded with a new plan (a named posture laid on it);
+    /// `line` says what changed.
+    Plan { plan: Plan, line: String },
 }
 
 /// State every component reads through context.
@@ -216,6 +219,10 @@ fn on_reply(state: AppState, reply: Reply) {
             state.progress.set(None);
             let pending = state.pending.get_untracked();
             state.pending.set(None);
+            let what = match &pending {
+                Some(Pending::Plan { line, .. }) => format!(": {line}"),
+                _ => String::new(),
+            };
             let take = match pending {
                 Some(Pending::Edit(edit)) => match state.take() {
                     Some(mut take) => {
@@ -226,6 +233,17 @@ fn on_reply(state: AppState, reply: Reply) {
                         take
                     }
                     None => return state.fail("there was no motion to edit"),
+                },
+                Some(Pending::Plan { plan, .. }) => match state.take() {
+                    Some(mut take) => {
+                        take.segments = crate::take::plan_segments(&plan, motion.joints.len());
+                        take.plan = Some(plan);
+                        take.motion = motion;
+                        // The review scored the motion before the posture.
+                        take.scores.clear();
+                        take
+                    }
+                    None => return state.fail("there was no motion to lay the posture on"),
                 },
                 Some(Pending::Link(link)) => {
                     let (plan, legacy) =
@@ -240,8 +258,8 @@ fn on_reply(state: AppState, reply: Reply) {
             };
             show(state, take);
             state.say(match notes.first() {
-                None => format!("Done in {:.1} s.", millis / 1000.0),
-                Some(note) => format!("Done in {:.1} s. Note: {note}", millis / 1000.0),
+                None => format!("Done in {:.1} s{what}.", millis / 1000.0),
+                Some(note) => format!("Done in {:.1} s{what}. Note: {note}", millis / 1000.0),
             });
         }
         // The page asks for no plan alone.

@@ -3,9 +3,12 @@
 //! carries it.
 
 use coma::plan::Plan;
+use coma::posture::script::PostureScript;
+use coma::posture::track::PostureTrack;
 use coma::session::Motion;
 use coma::share::{Edit, EditKind, LinkPlan, LinkSegment, RunRecord, SegmentScores, SharedMotion};
-use coma::timing::{frames_for_seconds, seconds, FRAMES_PER_TOKEN};
+use coma::skeleton::BodyPart;
+use coma::timing::{frames_for_seconds, seconds, FPS, FRAMES_PER_TOKEN};
 
 /// A stretch of the motion with its own text, in frames at 20 fps, and what the plan asked
 /// of it.
@@ -20,6 +23,24 @@ pub struct Segment {
     pub parts: Vec<(String, String)>,
     /// The root path, described ("a circle, clockwise").
     pub path: Option<String>,
+    /// The key poses of the segment's posture track, each in words
+    /// ([`PostureTrack::in_words`]); empty when the segment has none.
+    pub postures: Vec<String>,
+    /// The body parts the key poses drive: all four for a posture segment (the key poses are
+    /// the motion), fewer when they are held on those parts over the generated motion.
+    pub posture_parts: Vec<String>,
+    /// Where the key poses are reached on the timeline.
+    pub keys: Vec<KeyMark>,
+}
+
+/// A key pose on the timeline: the frame (20 fps, from the start of the take) at which it is
+/// reached, and its name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KeyMark {
+    pub frame: f64,
+    pub name: String,
+    /// Seconds it is held once reached.
+    pub hold: f64,
 }
 
 impl Segment {
@@ -151,10 +172,76 @@ pub fn plan_segments(plan: &Plan, frames: usize) -> Vec<Segment> {
                     .map(|(p, t)| (p.name().to_string(), t.chars().take(500).collect()))
                     .collect(),
                 path: s.trajectory.as_ref().map(|t| t.describe()),
+                postures: s.postures.as_ref().map_or_else(Vec::new, |t| {
+                    t.in_words()
+                        .into_iter()
+                        .map(|l| l.chars().take(2000).collect())
+                        .collect()
+                }),
+                posture_parts: s.postures.as_ref().map_or_else(Vec::new, |t| {
+                    t.parts.iter().map(|p| p.name().to_string()).collect()
+                }),
+                keys: s
+                    .postures
+                    .as_ref()
+                    .map_or_else(Vec::new, |t| key_marks(t, from..to)),
             }
         })
         .filter(|s| s.from < s.to)
         .collect()
+}
+
+/// Where the key poses of `track` are reached when it is laid over the frames `segment`: the
+/// track's own transitions and holds scaled to the frames it covers as the engine's go stage
+/// scales them (spare time lengthens the holds, or with none the transitions; missing time
+/// shortens everything), repetitions and the way back included.
+///
+/// An approximation by the natural timing: the go stage also lengthens a transition that would
+/// move a joint faster than it allows, and a posture segment that needs more time than its
+/// frames makes the motion longer; the marks do not follow either.
+pub fn key_marks(track: &PostureTrack, segment: std::ops::Range<usize>) -> Vec<KeyMark> {
+    let span = track.frames_within(segment);
+    if span.is_empty() || track.keys.is_empty() {
+        return Vec::new();
+    }
+    let seconds = span.len() as f64 / FPS;
+    let natural = track.natural_seconds().max(1e-6);
+    let holds: f64 = track.keys.iter().map(|k| k.script.hold).sum::<f64>() * track.repeat as f64;
+    let (hold_scale, move_scale) = if seconds >= natural && holds > 0.0 {
+        (1.0 + (seconds - natural) / holds, 1.0)
+    } else {
+        (seconds / natural, seconds / natural)
+    };
+    let back = if track.returns || track.repeat > 1 {
+        track.keys[0].transition * move_scale
+    } else {
+        0.0
+    };
+    let mut marks = Vec::new();
+    let mut t = 0.0;
+    for cycle in 0..track.repeat.max(1) {
+        if cycle > 0 {
+            t += back;
+        }
+        for k in &track.keys {
+            t += k.transition * move_scale;
+            let frame = span.start as f64 + (t * FPS).min(span.len() as f64);
+            marks.push(KeyMark {
+                frame,
+                name: k
+                    .script
+                    .name
+                    .as_deref()
+                    .unwrap_or("posture")
+                    .chars()
+                    .take(60)
+                    .collect(),
+                hold: k.script.hold * hold_scale,
+            });
+            t += k.script.hold * hold_scale;
+        }
+    }
+    marks
 }
 
 /// The segments as an older link's plan (written for takes without a planner's plan).
@@ -184,6 +271,9 @@ pub fn plan_from_link(
         base: String::new(),
         parts: Vec::new(),
         path: None,
+        postures: Vec::new(),
+        posture_parts: Vec::new(),
+        keys: Vec::new(),
     };
     match plan {
         LinkPlan::Planned(plan) => {
@@ -206,6 +296,75 @@ pub fn plan_from_link(
     (None, vec![whole(prompt, 0, frames)])
 }
 
+/// A named posture laid on a take: the plan to decode the take's tokens with, and where the
+/// posture went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PostureEdit {
+    pub plan: Plan,
+    /// The plan segment that holds the posture.
+    pub segment: usize,
+    /// The frames it covers (the asked range, cut at the end of that segment).
+    pub from: usize,
+    pub to: usize,
+    /// Whether the asked range went past the segment's end and was cut there.
+    pub cut: bool,
+    /// Whether the segment already had key poses, which the posture replaces.
+    pub replaced: bool,
+}
+
+/// The plan of `take` with `script` held on `parts` over the frames `from..to`: the segment
+/// in which the range starts (as the engine lays the plan's segments on the take's tokens)
+/// gets a posture track of that one key pose covering the range (cut at the segment's end),
+/// in place of any track it had. A take without a plan (an older link) cannot take one.
+pub fn with_posture(
+    take: &Take,
+    script: &PostureScript,
+    parts: Vec<BodyPart>,
+    from: usize,
+    to: usize,
+) -> Result<PostureEdit, String> {
+    let Some(mut plan) = take.plan.clone() else {
+        return Err(
+            "This motion came from an older link without a plan: generate it again to add a posture."
+                .into(),
+        );
+    };
+    if parts.is_empty() {
+        return Err("Tick the body parts to hold the posture on first.".into());
+    }
+    if from >= to {
+        return Err("The range must start before it ends.".into());
+    }
+    let ranges = coma::agents::pipeline::segment_ranges(&plan, &take.motion.tokens);
+    let Some(segment) = ranges.iter().position(|r| r.start <= from && from < r.end) else {
+        return Err(format!(
+            "The range starts at {:.1} s, after the motion ends ({:.1} s).",
+            seconds(from),
+            seconds(ranges.last().map_or(0, |r| r.end))
+        ));
+    };
+    let range = ranges[segment].clone();
+    let end = to.min(range.end);
+    if end - from < 2 {
+        return Err("The range is too short to hold a posture: choose at least 0.1 s.".into());
+    }
+    let at = |f: usize| (f - range.start) as f64 / FPS;
+    let track = PostureTrack {
+        within: Some([at(from), at(end)]),
+        ..PostureTrack::holding(parts, script.clone())
+    }
+    .checked()?;
+    let replaced = plan.segments[segment].postures.replace(track).is_some();
+    Ok(PostureEdit {
+        plan,
+        segment,
+        from,
+        to: end,
+        cut: end < to,
+        replaced,
+    })
+}
+
 /// One line for an edit of the history, as the Steps panel lists it.
 pub fn edit_line(edit: &Edit) -> String {
     let span = format!(
@@ -213,7 +372,7 @@ pub fn edit_line(edit: &Edit) -> String {
         seconds(edit.from_frame as usize),
         seconds(edit.to_frame as usize)
     );
-    let parts: Vec<&str> = coma::skeleton::BodyPart::ALL
+    let parts: Vec<&str> = BodyPart::ALL
         .iter()
         .enumerate()
         .filter(|(i, _)| edit.parts & (1 << i) != 0)
@@ -255,6 +414,9 @@ mod tests {
             base: String::new(),
             parts: Vec::new(),
             path: None,
+            postures: Vec::new(),
+            posture_parts: Vec::new(),
+            keys: Vec::new(),
         }
     }
 
@@ -294,6 +456,91 @@ mod tests {
         assert_eq!(plan_segments(&plan, 100).len(), 2);
         let (read, again) = plan_from_link(&LinkPlan::Planned(plan.clone()), "p", 240);
         assert_eq!((read.as_ref(), again), (Some(&plan), segments));
+    }
+
+    fn t_pose() -> PostureScript {
+        coma::posture::library::Library::builtin()
+            .get("T-pose")
+            .expect("the library has a T-pose")
+            .script
+            .clone()
+    }
+
+    #[test]
+    fn key_marks_follow_the_scaled_transitions_and_holds() {
+        let mut track = PostureTrack::holding(BodyPart::ALL.to_vec(), t_pose());
+        track.keys[0].script.hold = 1.0;
+        track.keys[0].transition = 0.5;
+        // 4 s of frames for 1.5 s of key poses: the hold takes the spare time.
+        let marks = key_marks(&track, 40..120);
+        assert_eq!(marks.len(), 1);
+        assert_eq!(marks[0].frame, 40.0 + 10.0);
+        assert!((marks[0].hold - 3.5).abs() < 1e-9, "{marks:?}");
+        assert_eq!(marks[0].name, "T-pose");
+        // Too little time shortens everything alike.
+        let marks = key_marks(&track, 0..15);
+        assert!((marks[0].frame - 5.0).abs() < 1e-9, "{marks:?}");
+        // Repetitions come back to the start between cycles; a range within the segment.
+        track.repeat = 2;
+        track.within = Some([1.0, 3.0]);
+        let marks = key_marks(&track, 40..120);
+        let frames: Vec<f64> = marks.iter().map(|m| m.frame).collect();
+        // 2 s for 2 × (0.5 + 1.0) + 2 × 0.5 s back = 4 s: everything at half speed.
+        assert_eq!(frames, vec![60.0 + 5.0, 60.0 + 5.0 + 10.0 + 5.0 + 5.0]);
+    }
+
+    #[test]
+    fn a_named_posture_goes_into_the_segment_where_its_range_starts() {
+        let plan = coma::agents::planner::offline::plan(
+            "A person walks forward waving the left hand, then turns right and bows",
+            None,
+        );
+        let tokens = coma::model::tokens::MotionTokens::new(vec![vec![vec![0; 60]; 1]; 4]).unwrap();
+        let motion = Motion {
+            tokens,
+            joints: vec![[[0.0; 3]; 22]; 240],
+            features: Vec::new(),
+        };
+        let take = Take::new(motion, "p".into(), 0, Vec::new(), Some(plan), Vec::new());
+        let arms = vec![BodyPart::LeftArm, BodyPart::RightArm];
+        // Segment 2 covers 80..180: the range is cut at its end.
+        let edit = with_posture(&take, &t_pose(), arms.clone(), 90, 300).unwrap();
+        assert_eq!(
+            (edit.segment, edit.from, edit.to, edit.cut),
+            (1, 90, 180, true)
+        );
+        assert!(!edit.replaced);
+        let track = edit.plan.segments[1].postures.as_ref().unwrap();
+        assert_eq!(track.within, Some([0.5, 5.0]));
+        assert_eq!(track.parts, arms);
+        // The plan view and the timeline show it.
+        let shown = plan_segments(&edit.plan, 240);
+        assert_eq!(shown[1].posture_parts, vec!["left arm", "right arm"]);
+        assert!(
+            shown[1].postures[0].starts_with("key 1 (T-pose"),
+            "{:?}",
+            shown[1].postures
+        );
+        assert!(shown[1]
+            .keys
+            .iter()
+            .all(|k| (90.0..180.0).contains(&k.frame)));
+        assert!(shown[0].postures.is_empty() && shown[0].keys.is_empty());
+        // Once more on the same segment: the posture replaces the one before.
+        let mut again = take.clone();
+        again.plan = Some(edit.plan);
+        assert!(
+            with_posture(&again, &t_pose(), arms.clone(), 100, 120)
+                .unwrap()
+                .replaced
+        );
+        // Ranges that cannot take a posture.
+        assert!(with_posture(&take, &t_pose(), arms.clone(), 240, 260).is_err());
+        assert!(with_posture(&take, &t_pose(), arms.clone(), 50, 50).is_err());
+        assert!(with_posture(&take, &t_pose(), Vec::new(), 0, 50).is_err());
+        let mut old = take.clone();
+        old.plan = None;
+        assert!(with_posture(&old, &t_pose(), arms, 0, 50).is_err());
     }
 
     #[test]

@@ -181,59 +181,12 @@ fn edit_locality_sample(
     }
 }
 
-/// Per frame, the root speed and the fastest joint speed (m/s).
-pub fn frame_speeds(poses: &[Pose]) -> Vec<(f64, f64)> {
-    poses
-        .windows(2)
-        .map(|w| {
-            let root = geom::dist(w[1][0], w[0][0]) * FPS;
-            let joint = w[1]
-                .iter()
-                .zip(&w[0])
-                .map(|(a, b)| geom::dist(*a, *b) * FPS)
-                .fold(0.0, f64::max);
-            (root, joint)
-        })
-        .collect()
-}
-
-/// Height above a motion's lowest foot position under which a foot counts as on the
-/// ground, metres.
-pub const CONTACT_HEIGHT: f64 = 0.05;
-/// Horizontal foot speed above which a grounded foot is skating, m/s (2.5 cm a frame).
-pub const SKATE_SPEED: f64 = 0.5;
-
-/// Foot skating: the fraction of frame pairs in which a foot (ankle or toe joint) stays within
-/// [`CONTACT_HEIGHT`] of the floor in both frames yet moves horizontally faster than
-/// [`SKATE_SPEED`]. The floor is the motion's lowest foot position.
-pub fn foot_skating(poses: &[Pose]) -> f64 {
-    let feet = [joint::L_ANKLE, joint::R_ANKLE, joint::L_FOOT, joint::R_FOOT];
-    let floor = poses
-        .iter()
-        .flat_map(|p| feet.iter().map(move |&f| p[f][1]))
-        .fold(f64::INFINITY, f64::min);
-    let mut skating = 0usize;
-    for w in poses.windows(2) {
-        let slides = feet.iter().any(|&f| {
-            let grounded =
-                w[0][f][1] - floor < CONTACT_HEIGHT && w[1][f][1] - floor < CONTACT_HEIGHT;
-            let dx = w[1][f][0] - w[0][f][0];
-            let dz = w[1][f][2] - w[0][f][2];
-            grounded && (dx * dx + dz * dz).sqrt() * FPS > SKATE_SPEED
-        });
-        skating += slides as usize;
-    }
-    skating as f64 / poses.len().saturating_sub(1).max(1) as f64
-}
-
-/// The `q`-quantile (0–1) of values.
-pub fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    values.sort_by(f64::total_cmp);
-    values[((values.len() - 1) as f64 * q).round() as usize]
-}
+// The pure measures of a motion live with the key-posture checks, which hold motions to the
+// same figures and sit below this module (the plan, which the evaluation reads, holds posture
+// tracks); the probes use them from there.
+pub use crate::posture::measure::{
+    foot_skating, frame_speeds, quantile, CONTACT_HEIGHT, SKATE_SPEED,
+};
 
 /// Result of the continuity probe.
 #[derive(Clone, Debug, serde::Serialize)]

@@ -5,10 +5,13 @@
 //! - [`script`]: a key pose as constraints in the describer's vocabulary, parsed and checked.
 //! - [`go`]: key poses placed in time — eased transitions, planted feet, flight for jumps,
 //!   turns and cycles — into a motion at 20 fps.
+//! - [`measure`]: foot skating, the lowest joint and joint speeds outside flight, against the
+//!   real test motions (`coma posture motions`).
 
 pub mod check;
 pub mod go;
 pub mod library;
+pub mod measure;
 pub mod script;
 pub mod solver;
 pub mod track;

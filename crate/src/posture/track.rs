@@ -483,16 +483,25 @@ fn lay_whole_body(
     // motion), so the join has no jump.
     let from = start.saturating_sub(1);
     let place = Placement::of(&out[from]);
-    let seconds = (end - from) as f64 / FPS;
+    // The features' last row leads to one more pose than they describe: a span that reaches it
+    // ends the motion, with nothing to join.
+    let next = (end + 1 < out.len()).then(|| out[end]);
+    // The way out into the next segment's first pose is part of the span.
+    let exit = if next.is_some() {
+        DEFAULT_TRANSITION_SECONDS
+    } else {
+        0.0
+    };
+    let seconds = ((end - from) as f64 / FPS - exit).max(0.5 * (end - from) as f64 / FPS);
     let mut keys = go_keys(track, place.to_local(&out[from]), solved, seconds);
-    let next = (end < out.len()).then(|| out[end]);
+    let track_keys = keys.len();
     if let Some(next) = next {
         // End in the shape the next segment starts with, so it follows without a jump.
         let shape = Placement::of(&next).to_local(&next);
         keys.push(KeyPose::new(shape, DEFAULT_TRANSITION_SECONDS, 0.0));
     }
     let (local, reached) = go::go_timed(&keys);
-    let checks: Vec<(usize, usize)> = key_frames(track, &keys, &reached)
+    let checks: Vec<(usize, usize)> = key_frames(track, &keys[..track_keys], &reached)
         .into_iter()
         .map(|(f, k)| (from + f, k))
         .collect();

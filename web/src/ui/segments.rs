@@ -1,13 +1,15 @@
 //! The plan on the timeline: a bar of the segments in time (each with its text, length and a
-//! Regenerate button) and, under it, what each asks for (base motion, body-part edits, path)
-//! with its review scores. While a run is in flight they show its plan, before the motion
-//! exists.
+//! Regenerate button, and a mark where each key pose is reached) and, under it, what each asks
+//! for (base motion, body-part edits, path, each key pose's script in words) with its review
+//! scores. While a run is in flight they show its plan, before the motion exists.
 
 use crate::app::{AppState, Pending};
 use crate::take::{plan_segments, Segment};
 use coma::session::Command;
 use coma::share::SegmentScores;
 use coma::share::{Edit, EditKind};
+use coma::skeleton::BodyPart;
+use coma::timing::FPS;
 use leptos::prelude::*;
 
 /// What the timeline shows.
@@ -97,6 +99,8 @@ pub fn SegmentBar(shown: Memo<Shown>) -> impl IntoView {
                             <div
                                 class="segment"
                                 style=format!("width: {width:.2}%")
+                                data-from=s.from
+                                data-to=s.to
                                 title=s.text.clone()
                             >
                                 <span class="segment-text">{s.text.clone()}</span>
@@ -115,6 +119,30 @@ pub fn SegmentBar(shown: Memo<Shown>) -> impl IntoView {
                     })
                     .collect_view()
             }}
+            {move || {
+                let Shown { segments, frames, .. } = shown.get();
+                let total = frames.max(1) as f64;
+                segments
+                    .into_iter()
+                    .flat_map(|s| s.keys)
+                    .map(|k| {
+                        let title = format!(
+                            "{} (reached at {:.1} s, held {:.1} s)",
+                            k.name,
+                            k.frame / FPS,
+                            k.hold,
+                        );
+                        view! {
+                            <div
+                                class="key-pose"
+                                style=format!("left: {:.2}%", (k.frame / total * 100.0).min(100.0))
+                                title=title
+                                data-name=k.name
+                            ></div>
+                        }
+                    })
+                    .collect_view()
+            }}
             <div
                 class="playhead"
                 style=move || {
@@ -125,6 +153,16 @@ pub fn SegmentBar(shown: Memo<Shown>) -> impl IntoView {
                 }
             ></div>
         </div>
+    }
+}
+
+/// What a segment's key poses drive, as a heading for their lines ("key poses of the whole
+/// body", "key poses held on the left arm, right arm"); `None` without key poses.
+fn posture_heading(parts: &[String]) -> Option<String> {
+    match parts.len() {
+        0 => None,
+        n if n == BodyPart::ALL.len() => Some("key poses of the whole body:".into()),
+        _ => Some(format!("key poses held on the {}:", parts.join(", "))),
     }
 }
 
@@ -170,6 +208,28 @@ pub fn PlanList(shown: Memo<Shown>) -> impl IntoView {
                                         })
                                         .collect_view()}
                                     {s.path.map(|p| view! { <li class="path">{format!("path: {p}")}</li> })}
+                                    {posture_heading(&s.posture_parts)
+                                        .map(|h| view! { <li class="postures">{h}</li> })}
+                                    {s
+                                        .postures
+                                        .into_iter()
+                                        .map(|line| {
+                                            // The name and hold, the constraints folded under
+                                            // it; the text reads as the whole line.
+                                            let (head, words) = match line.split_once("): ") {
+                                                Some((h, w)) => (format!("{h}):"), format!(" {w}")),
+                                                None => (line, String::new()),
+                                            };
+                                            view! {
+                                                <li class="posture-key">
+                                                    <details>
+                                                        <summary>{head}</summary>
+                                                        {words}
+                                                    </details>
+                                                </li>
+                                            }
+                                        })
+                                        .collect_view()}
                                     {score.map(|l| view! { <li class="score">{l}</li> })}
                                 </ul>
                             </li>

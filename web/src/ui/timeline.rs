@@ -1,7 +1,8 @@
-//! The timeline: the plan's segments (see [`super::segments`]) with the playhead; a time
-//! range and body parts to edit with an instruction (in-between or body-part edit); undo and
-//! redo.
+//! The timeline: the plan's segments (see [`super::segments`]) with the playhead and the key
+//! poses; a time range and body parts to edit with an instruction (in-between or body-part
+//! edit) or to hold a named posture on (see [`super::postures`]); undo and redo.
 
+use super::postures::PosturePicker;
 use super::segments::{next_seed, shown_segments, PlanList, SegmentBar};
 use crate::app::{AppState, Pending};
 use coma::session::Command;
@@ -120,6 +121,7 @@ pub fn Timeline() -> impl IntoView {
                 <label>
                     "From "
                     <input
+                        id="range-from"
                         type="number"
                         min="0"
                         step="0.2"
@@ -134,6 +136,7 @@ pub fn Timeline() -> impl IntoView {
                 <label>
                     "to "
                     <input
+                        id="range-to"
                         type="number"
                         min="0"
                         step="0.2"
@@ -154,6 +157,7 @@ pub fn Timeline() -> impl IntoView {
                             <label class="part">
                                 <input
                                     type="checkbox"
+                                    data-part=p.name()
                                     prop:checked=move || parts.get()[i]
                                     on:change=move |ev| {
                                         let on = event_target_checked(&ev);
@@ -195,6 +199,7 @@ pub fn Timeline() -> impl IntoView {
                     "Redo"
                 </button>
             </div>
+            <PosturePicker from to parts/>
         </div>
     }
 }

@@ -1,12 +1,28 @@
-//! `coma posture`: solve a named posture or a posture script, draw it, and check the solver.
+//! `coma posture`: solve a named posture or a posture script, draw it, check the solver, and
+//! measure motions made of key poses against the real test motions (`coma posture motions`).
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
+use coma::agents::llm::UreqTransport;
+use coma::agents::pipeline;
+use coma::dataset::motions::MotionSet;
+use coma::dataset::Split;
+use coma::eval::references::reference_motions;
+use coma::executor::block_on;
+use coma::features::{
+    features_to_joints, features_to_joints_with_final, joints_to_features, with_reference_bones,
+};
 use coma::posture::check::{fuzz, round_trip_random, round_trip_scripts, RoundTrip};
 use coma::posture::library::Library;
+use coma::posture::measure::{self, Measure, RealReference};
 use coma::posture::script::PostureScript;
-use coma::posture::solver::solve;
+use coma::posture::solver::{pose_of, rest_angles, solve};
+use coma::posture::track::{lay_tracks, PostureTrack, TrackSpan, DEFAULT_TRANSITION_SECONDS};
 use coma::render::{FilmstripOptions, View};
+use coma::session::{Command, Llm, Outcome};
+use coma::skeleton::{BodyPart, Offsets, Pose};
+use coma::timing::FPS;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -31,6 +47,35 @@ enum PostureCommand {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Motions from key poses held to the real test motions: foot skating, lowest joint and
+    /// the fastest joint outside flight, for every named posture and movement of the library
+    /// built by the go stage from standing, and (with --prompts) for the posture segments of
+    /// the engine's runs of a prompt set.
+    Motions(MotionsArgs),
+}
+
+#[derive(Args)]
+struct MotionsArgs {
+    /// A prompt set (eval/posture_prompts.json): run each prompt as `coma run` does, with no
+    /// LLM, and measure the frames of its posture segments.
+    #[arg(long)]
+    prompts: Option<PathBuf>,
+    /// Seed of the runs.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Review rounds per segment of the runs (K), as `coma run --rounds`.
+    #[arg(long, default_value_t = coma::agents::pipeline::DEFAULT_ROUNDS)]
+    rounds: usize,
+    /// Dataset (from `coma data build`) whose test motions give the reference figures.
+    #[arg(long, default_value = "data/bandai")]
+    data: PathBuf,
+    /// Folder of the model for the runs.
+    #[arg(long, default_value = "static/models")]
+    models: PathBuf,
+    /// Folder to write each library motion into, as a filmstrip (`<name>.png`) and joint
+    /// positions (`<name>.npy`, frames × 22 × 3, metres).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -91,6 +136,7 @@ pub fn run(args: PostureArgs) -> Result<()> {
             Ok(())
         }
         Some(PostureCommand::Filmstrips { out }) => write_filmstrips(&out),
+        Some(PostureCommand::Motions(motions)) => run_motions(motions),
         None => show(args.show),
     }
 }
@@ -254,6 +300,365 @@ fn run_check(args: CheckArgs) -> Result<()> {
         for m in &f.sample_messages {
             println!("  e.g. {m}");
         }
+    }
+    Ok(())
+}
+
+/// One measured motion: what it is (for a run, where its frames lie), whether key poses drive
+/// the whole body (or are held on some parts of a generated motion), and its figures.
+struct Measured {
+    name: String,
+    whole_body: bool,
+    measure: Measure,
+}
+
+/// A track laid over a standing rest pose as the engine lays a posture segment: half a second
+/// of standing, the track's key poses with the way out into standing again (the time the
+/// built-in planner gives such a segment), a second of standing; then put on the one skeleton
+/// as the engine returns every motion (features on the reference bones). Returns the motion,
+/// the notes and the frames the key poses made (from the last standing frame before them).
+fn from_rest(track: &PostureTrack) -> Result<(Vec<Pose>, Vec<String>, Range<usize>)> {
+    let rest = pose_of(&rest_angles());
+    let lead = (0.5 * FPS) as usize;
+    let span = ((track.natural_seconds() + DEFAULT_TRANSITION_SECONDS) * FPS).round() as usize;
+    let base = vec![rest; lead + span + FPS as usize];
+    let spans = [TrackSpan {
+        frames: lead..lead + span,
+        track,
+    }];
+    let (laid, notes) = lay_tracks(&base, &spans);
+    // Frames the key poses added (or, when they needed less time, took away).
+    let grown = laid.len() as isize - base.len() as isize;
+    // As `Session::motion` does: features of the joints (the last pose becomes the last row's
+    // velocities), on the reference bones, and the joints they describe.
+    let (features, _) = joints_to_features(&laid, &Offsets::reference())?;
+    let shown = features_to_joints(&with_reference_bones(&features));
+    // The key poses end in the next frame's shape, which they include.
+    let end = (((lead + span + 1) as isize + grown).max(lead as isize) as usize).min(shown.len());
+    Ok((shown, notes, lead - 1..end))
+}
+
+/// Every named posture (held from standing on the whole body) and movement of the library.
+fn library_motions(bar: f64, out: Option<&Path>) -> Result<Vec<Measured>> {
+    let library = Library::builtin();
+    let mut tracks: Vec<(String, PostureTrack)> = library
+        .postures
+        .iter()
+        .map(|p| {
+            (
+                p.name.clone(),
+                PostureTrack::holding(BodyPart::ALL.to_vec(), p.script.clone()),
+            )
+        })
+        .collect();
+    tracks.extend(
+        library
+            .actions
+            .iter()
+            .map(|a| (format!("{} (movement)", a.name), a.track(None, [0.0, 1.0]))),
+    );
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let mut rows = Vec::new();
+    for (name, track) in tracks {
+        let (motion, notes, frames) = from_rest(&track)?;
+        for n in notes {
+            eprintln!("note: {name}: {n}");
+        }
+        let made = &motion[frames];
+        if let Some(dir) = out {
+            let file: String = name
+                .to_lowercase()
+                .chars()
+                .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+                .collect();
+            let options = FilmstripOptions {
+                frames: 12,
+                columns: 6,
+                title: Some(name.clone()),
+                view: View::ThreeQuarter,
+                ..FilmstripOptions::default()
+            };
+            coma::render::write_filmstrip(&dir.join(format!("{file}.png")), made, &options)?;
+            coma::motion_file::write_motion(
+                &dir.join(format!("{file}.npy")),
+                &coma::motion_file::MotionData::Joints(made.to_vec()),
+                false,
+            )?;
+        }
+        rows.push(Measured {
+            measure: measure::measure(made, bar),
+            whole_body: track.whole_body(),
+            name,
+        });
+    }
+    Ok(rows)
+}
+
+/// Where the posture tracks of a run's plan lie in its motion: per track (in the order they
+/// are laid), the segment's index, whether it drives the whole body, and the frames it made.
+/// The motion is laid again here, a track at a time, to follow how whole-body tracks lengthen
+/// or shorten it (as `pipeline::lay_postures` does in one go); the last figure is the length of
+/// the whole laid motion (joints, with the features' final frame).
+fn posture_frames(
+    model: &coma::model::MotionModel,
+    plan: &coma::plan::Plan,
+    tokens: &coma::model::tokens::MotionTokens,
+) -> (Vec<(usize, bool, Range<usize>)>, usize) {
+    let features = block_on(pipeline::motion_features(model, plan, tokens)).0;
+    let base = features_to_joints_with_final(&with_reference_bones(&features));
+    let mut spans: Vec<(usize, TrackSpan)> = plan
+        .segments
+        .iter()
+        .zip(pipeline::segment_ranges(plan, tokens))
+        .enumerate()
+        .filter_map(|(i, (s, frames))| {
+            s.postures.as_ref().map(|track| {
+                (
+                    i,
+                    TrackSpan {
+                        frames: track.frames_within(frames),
+                        track,
+                    },
+                )
+            })
+        })
+        .collect();
+    spans.sort_by_key(|(_, s)| s.frames.start);
+    let only: Vec<TrackSpan> = spans.iter().map(|(_, s)| s.clone()).collect();
+    let length = |k: usize| lay_tracks(&base, &only[..k]).0.len();
+    let mut out = Vec::new();
+    let mut before = base.len();
+    for (k, (segment, span)) in spans.iter().enumerate() {
+        let after = length(k + 1);
+        let shift = before as isize - base.len() as isize;
+        // As `lay_tracks` places the span.
+        let start = (span.frames.start as isize + shift).clamp(0, before as isize - 1) as usize;
+        let end = ((span.frames.end as isize + shift).max(start as isize + 1) as usize).min(before);
+        let frames = if span.track.whole_body() {
+            let next = usize::from(end < before);
+            start.saturating_sub(1)..(end + after + next).saturating_sub(before)
+        } else {
+            start..end
+        };
+        out.push((*segment, span.track.whole_body(), frames));
+        before = after;
+    }
+    (out, before)
+}
+
+/// Runs every prompt of a set as `coma run` does (no LLM) and measures its posture tracks.
+fn prompt_motions(args: &MotionsArgs, set: &Path, bar: f64) -> Result<(Vec<Measured>, usize)> {
+    let prompts = coma::agents::planner::prompt_set::load(set)?;
+    let session = crate::common::load_session(&args.models)?;
+    let mut rows = Vec::new();
+    let mut without = 0;
+    for p in &prompts {
+        let command = Command::Run {
+            prompt: p.prompt.clone(),
+            seed: args.seed,
+            rounds: args.rounds,
+            seconds: None,
+            plan: None,
+        };
+        let outcome = block_on(session.execute(command, &Llm::<UreqTransport>::Off, &mut |_| {}))?;
+        let Outcome::Run(run) = outcome else {
+            bail!("the engine answered a run with something else");
+        };
+        if !run.plan.segments.iter().any(|s| s.postures.is_some()) {
+            without += 1;
+            eprintln!("no posture segment: {}", p.prompt);
+            continue;
+        }
+        let joints = features_to_joints(&run.motion.features);
+        let (spans, laid) = posture_frames(session.model(), &run.plan, &run.motion.tokens);
+        if laid != joints.len() + 1 {
+            eprintln!(
+                "note: '{}': the motion has {} frames, laying its postures again gave {}",
+                p.prompt,
+                joints.len(),
+                laid.saturating_sub(1)
+            );
+        }
+        for (segment, whole, frames) in spans {
+            let frames = frames.start.min(joints.len())..frames.end.min(joints.len());
+            let s = &run.plan.segments[segment];
+            let keys: Vec<&str> = s
+                .postures
+                .iter()
+                .flat_map(|t| &t.keys)
+                .filter_map(|k| k.script.name.as_deref())
+                .collect();
+            rows.push(Measured {
+                name: format!(
+                    "\"{}\" seg {} {}[{}] frames {}..{}",
+                    p.prompt,
+                    segment + 1,
+                    if whole { "" } else { "on parts " },
+                    keys.join(", "),
+                    frames.start,
+                    frames.end
+                ),
+                whole_body: whole,
+                measure: measure::measure(&joints[frames], bar),
+            });
+        }
+    }
+    Ok((rows, without))
+}
+
+fn print_measured(rows: &[Measured], real: &RealReference, bar: f64) {
+    println!(
+        "  {:>6} {:>8} {:>10} {:>6} {:>12}  {:<30} {:>5}  motion",
+        "frames", "skating", "lowest cm", "flight", "fastest m/s", "(joint at s)", "pass"
+    );
+    for r in rows {
+        let m = &r.measure;
+        let (fastest, at) = match &m.fastest {
+            Some(f) => (
+                format!("{:.2}", f.speed),
+                format!("({} at {:.2} s)", f.joint_name(), f.frame as f64 / FPS),
+            ),
+            None => ("-".into(), String::new()),
+        };
+        println!(
+            "  {:>6} {:>8.3} {:>10.1} {:>6} {:>12}  {:<30} {:>5}  {}",
+            m.frames,
+            m.skating,
+            m.lowest_m * 100.0,
+            m.flight_frames,
+            fastest,
+            at,
+            if m.passes(real.skating) { "yes" } else { "NO" },
+            r.name
+        );
+    }
+    if rows.is_empty() {
+        return;
+    }
+    let n = rows.len() as f64;
+    let mean = rows.iter().map(|r| r.measure.skating).sum::<f64>() / n;
+    let pooled = {
+        let pairs: f64 = rows
+            .iter()
+            .map(|r| r.measure.frames.saturating_sub(1) as f64)
+            .sum();
+        rows.iter()
+            .map(|r| r.measure.skating * r.measure.frames.saturating_sub(1) as f64)
+            .sum::<f64>()
+            / pairs.max(1.0)
+    };
+    let worst_skate = rows
+        .iter()
+        .max_by(|a, b| a.measure.skating.total_cmp(&b.measure.skating))
+        .unwrap();
+    let lowest = rows
+        .iter()
+        .min_by(|a, b| a.measure.lowest_m.total_cmp(&b.measure.lowest_m))
+        .unwrap();
+    let fastest = rows
+        .iter()
+        .filter_map(|r| r.measure.fastest.map(|f| (r, f)))
+        .max_by(|a, b| a.1.speed.total_cmp(&b.1.speed));
+    let over: usize = rows.iter().map(|r| r.measure.pairs_over).sum();
+    let over_motions = rows.iter().filter(|r| r.measure.pairs_over > 0).count();
+    let skating_over = rows
+        .iter()
+        .filter(|r| r.measure.skating > real.skating)
+        .count();
+    let under = rows
+        .iter()
+        .filter(|r| r.measure.lowest_m < -measure::MAX_BELOW_FLOOR_M)
+        .count();
+    println!(
+        "  overall, {} motions: foot skating mean {mean:.3}, pooled over frames {pooled:.3} \
+         (real {:.3}; {skating_over} motions above it, worst {:.3}: {})",
+        rows.len(),
+        real.skating,
+        worst_skate.measure.skating,
+        worst_skate.name
+    );
+    println!(
+        "  lowest joint {:.1} cm ({}); {under} motions more than {:.0} cm below the floor",
+        lowest.measure.lowest_m * 100.0,
+        lowest.name,
+        measure::MAX_BELOW_FLOOR_M * 100.0
+    );
+    if let Some((r, f)) = fastest {
+        println!(
+            "  fastest joint outside flight {:.2} m/s ({} at {:.2} s of {}); real 99th \
+             percentile {bar:.2} m/s: {over} frame pairs in {over_motions} motions above it",
+            f.speed,
+            f.joint_name(),
+            f.frame as f64 / FPS,
+            r.name
+        );
+    }
+    println!(
+        "  {} of {} motions meet all three",
+        rows.iter()
+            .filter(|r| r.measure.passes(real.skating))
+            .count(),
+        rows.len()
+    );
+}
+
+fn run_motions(args: MotionsArgs) -> Result<()> {
+    let set = MotionSet::load(&args.data, Split::Test).with_context(|| {
+        format!(
+            "reading the test motions of {} (build them with `coma data build --bandai \
+             ../shared/data/bandai-namco-bvh.tar.xz --out {}`)",
+            args.data.display(),
+            args.data.display()
+        )
+    })?;
+    let real = measure::real_reference(&reference_motions(&set));
+    let bar = real.p99_fastest;
+    println!(
+        "real test motions of {} ({} motions, {} frames): foot skating {:.3} (mean over \
+         motions); lowest joint {:.1} cm; 99th percentile of the fastest joint's speed per \
+         frame {:.2} m/s (outside flight {:.2}), of every joint's speed {:.2} m/s",
+        args.data.display(),
+        real.motions,
+        real.frames,
+        real.skating,
+        real.lowest_m * 100.0,
+        real.p99_fastest,
+        real.p99_fastest_outside_flight,
+        real.p99_joint
+    );
+    println!(
+        "bars: foot skating <= {:.3}; no joint below {:.0} cm; no joint faster than {bar:.2} \
+         m/s outside flight (no joint within {:.0} cm of the floor) and the frames next to it",
+        real.skating,
+        -measure::MAX_BELOW_FLOOR_M * 100.0,
+        measure::FLIGHT_CLEARANCE_M * 100.0
+    );
+    println!();
+    println!(
+        "library motions (go stage from standing; postures held on the whole body, movements \
+         once, forward):"
+    );
+    let library = library_motions(bar, args.out.as_deref())?;
+    print_measured(&library, &real, bar);
+    if let Some(set) = &args.prompts {
+        println!();
+        let (rows, without) = prompt_motions(&args, set, bar)?;
+        println!(
+            "posture tracks of the engine's runs of {} (seed {}, {} review rounds, no LLM; {} \
+             prompts planned without one):",
+            set.display(),
+            args.seed,
+            args.rounds,
+            without
+        );
+        let (whole, parts): (Vec<Measured>, Vec<Measured>) =
+            rows.into_iter().partition(|r| r.whole_body);
+        println!(" posture segments (key poses on the whole body):");
+        print_measured(&whole, &real, bar);
+        println!(" postures held on parts over the generated motion:");
+        print_measured(&parts, &real, bar);
     }
     Ok(())
 }
