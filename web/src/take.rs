@@ -191,10 +191,8 @@ pub fn plan_segments(plan: &Plan, frames: usize) -> Vec<Segment> {
         .collect()
 }
 
-/// Where the key poses of `track` are reached when it is laid over the frames `segment`: the
-/// track's own transitions and holds scaled to the frames it covers as the engine's go stage
-/// scales them (spare time lengthens the holds, or with none the transitions; missing time
-/// shortens everything), repetitions and the way back included.
+/// Where the key poses of `track` are reached when it is laid over the frames `segment`, by the
+/// engine's own timing ([`PostureTrack::key_times`]).
 ///
 /// An approximation by the natural timing: the go stage also lengthens a transition that would
 /// move a joint faster than it allows, and a posture segment that needs more time than its
@@ -205,42 +203,22 @@ pub fn key_marks(track: &PostureTrack, segment: std::ops::Range<usize>) -> Vec<K
         return Vec::new();
     }
     let seconds = span.len() as f64 / FPS;
-    let natural = track.natural_seconds().max(1e-6);
-    let holds: f64 = track.keys.iter().map(|k| k.script.hold).sum::<f64>() * track.repeat as f64;
-    let (hold_scale, move_scale) = if seconds >= natural && holds > 0.0 {
-        (1.0 + (seconds - natural) / holds, 1.0)
-    } else {
-        (seconds / natural, seconds / natural)
-    };
-    let back = if track.returns || track.repeat > 1 {
-        track.keys[0].transition * move_scale
-    } else {
-        0.0
-    };
-    let mut marks = Vec::new();
-    let mut t = 0.0;
-    for cycle in 0..track.repeat.max(1) {
-        if cycle > 0 {
-            t += back;
-        }
-        for k in &track.keys {
-            t += k.transition * move_scale;
-            let frame = span.start as f64 + (t * FPS).min(span.len() as f64);
-            marks.push(KeyMark {
-                frame,
-                name: k
-                    .script
-                    .name
-                    .as_deref()
-                    .unwrap_or("posture")
-                    .chars()
-                    .take(60)
-                    .collect(),
-                hold: k.script.hold * hold_scale,
-            });
-            t += k.script.hold * hold_scale;
-        }
-    }
+    let marks = track
+        .key_times(seconds)
+        .into_iter()
+        .map(|(t, hold, i)| KeyMark {
+            frame: span.start as f64 + (t * FPS).min(span.len() as f64),
+            name: track.keys[i]
+                .script
+                .name
+                .as_deref()
+                .unwrap_or("posture")
+                .chars()
+                .take(60)
+                .collect(),
+            hold,
+        })
+        .collect();
     marks
 }
 

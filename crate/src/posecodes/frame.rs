@@ -172,7 +172,7 @@ pub(super) fn foot_clearance(pose: &Pose, leg: &LegJoints, floor: f64) -> f64 {
 
 /// The inner angle at `b` between the bones to `a` and `c`, in degrees; 180 when a bone has no
 /// length, so a degenerate limb reads as straight rather than as NaN.
-pub(super) fn joint_angle_deg(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+pub fn joint_angle_deg(a: Vec3, b: Vec3, c: Vec3) -> f64 {
     let u = geom::sub(a, b);
     let v = geom::sub(c, b);
     let (nu, nv) = (geom::norm(u), geom::norm(v));

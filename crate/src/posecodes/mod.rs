@@ -34,9 +34,9 @@ pub use body::{
     PLANK_PELVIS_M, TWIST_MIN_DEG, UPRIGHT_MAX_DEG,
 };
 pub use frame::{
-    facing, floor_height, frame_codes, ArmCodes, Bend, Depth, Distance, FrameCodes, LegCodes,
-    Orientation, Side, Vertical, CLOSE_MAX_M, DEPTH_BAND_M, FOOT_CONTACT_M, HEIGHT_BAND_M,
-    HORIZONTAL_MIN_DEG, KNEE_CONTACT_M, MIDLINE_BAND_M, PARTIALLY_BENT_MIN_DEG,
+    facing, floor_height, frame_codes, joint_angle_deg, ArmCodes, Bend, Depth, Distance,
+    FrameCodes, LegCodes, Orientation, Side, Vertical, CLOSE_MAX_M, DEPTH_BAND_M, FOOT_CONTACT_M,
+    HEIGHT_BAND_M, HORIZONTAL_MIN_DEG, KNEE_CONTACT_M, MIDLINE_BAND_M, PARTIALLY_BENT_MIN_DEG,
     SHOULDER_WIDTH_MAX_M, SLIGHTLY_BENT_MIN_DEG, SPREAD_MAX_M, STRAIGHT_MIN_DEG, VERTICAL_MAX_DEG,
 };
 pub use motion::{

@@ -358,32 +358,9 @@ struct Timeline {
     total: f64,
 }
 
-fn ease(u: f64) -> f64 {
-    let u = u.clamp(0.0, 1.0);
-    u * u * (3.0 - 2.0 * u)
-}
-
 /// 0 → 1 over the first quarter, 1 → 0 over the last: the lift of a step.
 fn bump(r: f64) -> f64 {
-    ease(r / 0.25).min(ease((1.0 - r) / 0.25))
-}
-
-fn slerp(a: Quat, b: Quat, t: f64) -> Quat {
-    let mut b = b.0;
-    let mut cos: f64 = a.0.iter().zip(&b).map(|(x, y)| x * y).sum();
-    // q and −q are the same rotation; the shorter arc avoids a needless full turn of the bone.
-    if cos < 0.0 {
-        b = b.map(|v| -v);
-        cos = -cos;
-    }
-    let (wa, wb) = if cos > 0.9995 {
-        (1.0 - t, t)
-    } else {
-        let theta = cos.min(1.0).acos();
-        let sin = theta.sin();
-        (((1.0 - t) * theta).sin() / sin, (t * theta).sin() / sin)
-    };
-    Quat(std::array::from_fn(|i| wa * a.0[i] + wb * b[i])).normalized()
+    geom::ease(r / 0.25).min(geom::ease((1.0 - r) / 0.25))
 }
 
 fn yawed(yaw: f64, v: Vec3) -> Vec3 {
@@ -849,7 +826,7 @@ impl Timeline {
     /// pelvis `extra` metres above where it keeps the supports on the floor.
     fn body(&self, b: usize, sigma: f64, yaw: f64, ground: Vec3, extra: f64) -> Pose {
         let (ka, kb, plan) = (&self.keys[b - 1], &self.keys[b], &self.plans[b]);
-        let rots: Rotations = std::array::from_fn(|j| slerp(ka.rots[j], kb.rots[j], sigma));
+        let rots: Rotations = std::array::from_fn(|j| ka.rots[j].slerp(kb.rots[j], sigma));
         let mut pose = pose_of(&rots, yaw, [0.0; 3], &self.offsets);
         let pelvis = geom::lerp(ka.pelvis, kb.pelvis, sigma);
         // Interpolated shapes put the feet at heights neither key has; measuring the support
@@ -894,7 +871,7 @@ impl Timeline {
         let mut active = None;
         for k in 0..steps {
             // Each step lands where the limb will be when the body has done this step's share.
-            let to = ease((k + 1) as f64 / steps as f64);
+            let to = geom::ease((k + 1) as f64 / steps as f64);
             let start = (k * of + slot) as f64 / windows;
             if u < start {
                 break;
@@ -915,8 +892,8 @@ impl Timeline {
                 }
             }
             Some((r, to)) => {
-                let across = self.natural(b, from + (to - from) * ease((r - 0.2) / 0.6));
-                let up = self.natural(b, from + (to - from) * ease(r));
+                let across = self.natural(b, from + (to - from) * geom::ease((r - 0.2) / 0.6));
+                let up = self.natural(b, from + (to - from) * geom::ease(r));
                 let stride = dist_xz(
                     self.natural(b, from)[limb.end],
                     self.natural(b, to)[limb.end],
@@ -941,7 +918,7 @@ impl Timeline {
     /// (0–1), with the pelvis `dip` metres lower; `launch` adds the push-off's countermovement.
     fn ease_pose(&self, b: usize, u: f64, dip: f64, launch: bool) -> Pose {
         let (ka, kb, plan) = (&self.keys[b - 1], &self.keys[b], &self.plans[b]);
-        let s = ease(u);
+        let s = geom::ease(u);
         let mut targets = [None; 4];
         let (yaw, mut pose) = match kb.flight {
             Some(f) => {
@@ -958,7 +935,7 @@ impl Timeline {
                 shift_y(&mut pose, dip + spring);
                 // If the take-off shape's feet are elsewhere, they slide there at the very end
                 // rather than jump at take-off.
-                let handover = ease((u - 0.6) / 0.4);
+                let handover = geom::ease((u - 0.6) / 0.4);
                 for (li, limb) in LIMBS.iter().enumerate() {
                     if plan.limbs[li] == LimbMode::PushOff {
                         let pin = |e: usize| {

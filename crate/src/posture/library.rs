@@ -132,6 +132,14 @@ pub enum Named<'a> {
 }
 
 impl<'a> Named<'a> {
+    /// Every phrase that names it, lower case, the name first.
+    pub fn phrases(&self) -> Vec<String> {
+        match self {
+            Named::Posture(p) => p.phrases().collect(),
+            Named::Action(a) => a.phrases().collect(),
+        }
+    }
+
     /// Its name.
     pub fn name(&self) -> &'a str {
         match self {
@@ -359,10 +367,7 @@ impl Library {
     fn unambiguous(&self) -> Result<(), LibraryError> {
         let mut seen: Vec<(String, &str)> = Vec::new();
         for named in self.all() {
-            let phrases: Vec<String> = match named {
-                Named::Posture(p) => p.phrases().collect(),
-                Named::Action(a) => a.phrases().collect(),
-            };
+            let phrases = named.phrases();
             for phrase in phrases {
                 let phrase = normalise(&phrase);
                 match seen.iter().find(|(s, _)| *s == phrase) {
@@ -414,10 +419,7 @@ impl Library {
         let (flat, map) = normalise_with_map(text);
         let mut found: Vec<(std::ops::Range<usize>, Named<'_>)> = Vec::new();
         for named in self.all() {
-            let phrases: Vec<String> = match named {
-                Named::Posture(p) => p.phrases().collect(),
-                Named::Action(a) => a.phrases().collect(),
-            };
+            let phrases = named.phrases();
             for phrase in phrases {
                 let phrase = normalise(&phrase);
                 if phrase.is_empty() {

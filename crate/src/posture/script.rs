@@ -77,15 +77,7 @@ impl Hinge {
     /// Inner angle of the hinge in degrees (180 = straight).
     pub fn angle_deg(self, pose: &Pose) -> f64 {
         let [a, b, c] = self.joints();
-        let (u, v) = (geom::sub(pose[a], pose[b]), geom::sub(pose[c], pose[b]));
-        let (nu, nv) = (geom::norm(u), geom::norm(v));
-        if nu < 1e-9 || nv < 1e-9 {
-            return 180.0;
-        }
-        (geom::dot(u, v) / (nu * nv))
-            .clamp(-1.0, 1.0)
-            .acos()
-            .to_degrees()
+        posecodes::joint_angle_deg(pose[a], pose[b], pose[c])
     }
 }
 

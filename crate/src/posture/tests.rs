@@ -132,3 +132,22 @@ fn the_schema_lists_every_constraint_kind() {
     assert_eq!(kinds.len(), 8);
     let _ = Constraint::Lean { is: Lean::Upright };
 }
+
+#[test]
+fn every_named_posture_and_movement_key_is_read_back_in_full() {
+    let library = super::library::Library::builtin();
+    let scripts = library
+        .postures
+        .iter()
+        .map(|p| (p.name.clone(), &p.script))
+        .chain(
+            library
+                .actions
+                .iter()
+                .flat_map(|a| a.keys.iter().map(move |k| (a.name.clone(), &k.script))),
+        );
+    let report = super::check::round_trip_scripts(scripts, &clock);
+    assert!(report.scripts >= 40 + 8, "{} scripts", report.scripts);
+    assert_eq!(report.read_back, report.constraints, "{:#?}", report.misses);
+    assert_eq!(report.limit_breaks + report.below_floor, 0);
+}

@@ -226,6 +226,45 @@ impl PostureTrack {
         once * self.repeat as f64 + back * self.repeat.max(1) as f64
     }
 
+    /// The factors `(holds, transitions)` that make the track last `seconds`: spare time
+    /// lengthens the holds (or, with none, the transitions), missing time shortens everything.
+    pub fn time_scales(&self, seconds: f64) -> (f64, f64) {
+        let natural = self.natural_seconds().max(1e-6);
+        let holds: f64 = self.keys.iter().map(|k| k.script.hold).sum::<f64>() * self.repeat as f64;
+        if seconds >= natural && holds > 0.0 {
+            (1.0 + (seconds - natural) / holds, 1.0)
+        } else {
+            (seconds / natural, seconds / natural)
+        }
+    }
+
+    /// When each key pose is reached when the track lasts `seconds`, by its own timing scaled
+    /// as [`PostureTrack::time_scales`] says, repetitions and the way back included: `(reached
+    /// s, held s, key index)`. The go stage may still lengthen a transition that would move a
+    /// joint too fast; these times do not follow that.
+    pub fn key_times(&self, seconds: f64) -> Vec<(f64, f64, usize)> {
+        let (hold_scale, move_scale) = self.time_scales(seconds);
+        let back = if self.returns || self.repeat > 1 {
+            self.keys[0].transition * move_scale
+        } else {
+            0.0
+        };
+        let mut out = Vec::new();
+        let mut t = 0.0;
+        for cycle in 0..self.repeat.max(1) {
+            if cycle > 0 {
+                t += back;
+            }
+            for (i, k) in self.keys.iter().enumerate() {
+                t += k.transition * move_scale;
+                let hold = k.script.hold * hold_scale;
+                out.push((t, hold, i));
+                t += hold;
+            }
+        }
+        out
+    }
+
     /// The track in words for the plan view ("key 1 (squat, held 0.6 s): the left knee is …").
     pub fn in_words(&self) -> Vec<String> {
         self.keys
@@ -371,13 +410,7 @@ fn review_keys(motion: &[Pose], track: &PostureTrack, checks: &[(usize, usize)])
 /// with transitions and holds scaled so that the track fills `seconds`: spare time lengthens
 /// the holds (or, with none, the transitions), missing time shortens everything.
 fn go_keys(track: &PostureTrack, start: Pose, solved: &[Pose], seconds: f64) -> Vec<KeyPose> {
-    let natural = track.natural_seconds().max(1e-6);
-    let holds: f64 = track.keys.iter().map(|k| k.script.hold).sum::<f64>() * track.repeat as f64;
-    let (hold_scale, move_scale) = if seconds >= natural && holds > 0.0 {
-        (1.0 + (seconds - natural) / holds, 1.0)
-    } else {
-        (seconds / natural, seconds / natural)
-    };
+    let (hold_scale, move_scale) = track.time_scales(seconds);
     let first = KeyPose::new(start, 0.0, 0.0);
     let mut cycle = vec![first];
     for (k, pose) in track.keys.iter().zip(solved) {

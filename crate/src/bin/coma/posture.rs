@@ -260,6 +260,16 @@ fn run_check(args: CheckArgs) -> Result<()> {
         &now,
     );
     print_round_trip("named library", &named);
+    let keys = round_trip_scripts(
+        library.actions.iter().flat_map(|a| {
+            a.keys.iter().map(move |k| {
+                let key = k.script.name.as_deref().unwrap_or("key");
+                (format!("{}: {key}", a.name), &k.script)
+            })
+        }),
+        &now,
+    );
+    print_round_trip("key poses of the movements", &keys);
     if let Some(path) = &args.scripts {
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
