@@ -580,3 +580,99 @@ test("the page plans through a real local LLM server", {
     await stop(server);
   }
 });
+
+test("a path drawn on the ground with the pointer is walked, undone, redone and shared", { timeout: 30 * 60_000 }, async () => {
+  const server = serve();
+  const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
+  try {
+    await waitForServer();
+    const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+    const opened = await open(context, BASE);
+    const { page } = opened;
+    await modelLoaded(page);
+    let started = Date.now();
+    const walked = await walk(page, 4);
+    console.log(`a 2 s walk generated in ${((Date.now() - started) / 1000).toFixed(1)} s in the page`);
+    const historyBefore = await page.locator("#history li").allTextContents();
+    const draw = page.locator("#draw-path");
+    const status = () => page.locator("#status").textContent();
+
+    // Esc leaves draw mode and changes nothing.
+    await draw.click();
+    assert.equal(await draw.getAttribute("aria-pressed"), "true");
+    await page.keyboard.press("Escape");
+    assert.equal(await draw.getAttribute("aria-pressed"), "false");
+    assert.match(await status(), /cancelled/);
+    assert.equal(await jointsHash(page), walked.hash);
+
+    // Draw mode: the playhead goes to the segment's start and the camera settles there.
+    await draw.click();
+    await page.waitForTimeout(1500);
+    const box = await page.locator("#view").boundingBox();
+    const at = ([fx, fy]) => [box.x + box.width * fx, box.y + box.height * fy];
+    const drawn = async (points, whileDown = async () => {}) => {
+      await page.mouse.move(...at(points[0]));
+      await page.mouse.down();
+      for (const p of points.slice(1)) await page.mouse.move(...at(p), { steps: 4 });
+      await whileDown();
+      await page.mouse.up();
+    };
+
+    // A click is no path: a message, the same take, still drawing.
+    await drawn([[0.5, 0.8]]);
+    assert.match(await status(), /No path laid: a drawn path needs at least 2 points/);
+    assert.equal(await jointsHash(page), walked.hash);
+    assert.equal(await draw.getAttribute("aria-pressed"), "true");
+
+    // An L on the ground: away from the camera, then across; on release the root walks it.
+    const before = await canvasPixels(page);
+    started = Date.now();
+    await drawn([[0.45, 0.9], [0.45, 0.8], [0.45, 0.7], [0.45, 0.62], [0.55, 0.62], [0.65, 0.62], [0.75, 0.62]], async () => {
+      // The stroke grows while the pointer is down (the screenshot shows it on the ground).
+      assert.match(await page.locator(".path-draw .hint").textContent(), /^\d+\.\d m drawn$/);
+      await page.waitForTimeout(200);
+      await page.locator(".viewer").screenshot({ path: join(SHOTS, "page-path-drawing.png") });
+    });
+    await page.waitForFunction((h) => {
+      const v = document.querySelector(".viewer")?.dataset.jointsHash;
+      return v && v !== h && !document.querySelector("#generate").disabled;
+    }, walked.hash, { timeout: LOAD_TIMEOUT });
+    const pathHash = await jointsHash(page);
+    const said = await status();
+    console.log(`drawn path laid in ${((Date.now() - started) / 1000).toFixed(1)} s: ${said}`);
+    assert.match(said, /^Done in .*: path drawn: \d+\.\d m, (scaled to the walk's|walked at an even pace over) \d+\.\d m/);
+    assert.notEqual(await canvasPixels(page), before, "the canvas did not change");
+    assert.equal(await draw.getAttribute("aria-pressed"), "false", "draw mode ends with the stroke");
+    const history = await page.locator("#history li").allTextContents();
+    assert.equal(history.length, historyBefore.length + 1, history.join(" | "));
+    assert.match(history.at(-1), /^path "a drawn path \(\d+\.\d m, \d+ points\)" \(0\.0–\d+\.\d s\)$/);
+    assert.match(await page.locator(".plan .path").textContent(), /^path: a drawn path/);
+
+    // Undo goes back to the walk, redo brings the path back.
+    await page.click("#undo");
+    await shows(page, walked.hash);
+    assert.deepEqual(await page.locator("#history li").allTextContents(), historyBefore);
+    assert.equal(await page.locator(".plan .path").count(), 0);
+    await page.click("#redo");
+    await shows(page, pathHash);
+    assert.deepEqual(await page.locator("#history li").allTextContents(), history);
+
+    // The share link rebuilds the same joints, path edit and all, in a fresh page.
+    await page.click("#share");
+    const link = await page.locator("#share-link").inputValue();
+    const fresh = await open(await browser.newContext({ viewport: { width: 1280, height: 800 } }), link);
+    started = Date.now();
+    await shows(fresh.page, pathHash);
+    console.log(`the drawn path's link rebuilt the same joints in ${((Date.now() - started) / 1000).toFixed(1)} s (from load)`);
+    assert.deepEqual(await fresh.page.locator("#history li").allTextContents(), history, "the link keeps the path edit");
+    assert.equal(await fresh.page.locator(".plan .path").textContent(), await page.locator(".plan .path").textContent());
+
+    for (const p of [opened, fresh]) {
+      assert.deepEqual(p.problems, [], "errors in the browser console");
+      assert.deepEqual(p.stats.outside, [], "the page sent something out");
+    }
+  } finally {
+    await browser.close();
+    await stop(server);
+  }
+});

@@ -45,9 +45,14 @@ pub enum Pending {
     Edit(Edit),
     /// A take rebuilt from a share link.
     Link(share::SharedMotion),
-    /// The current take's tokens decoded with a new plan (a named posture laid on it);
-    /// `line` says what changed.
-    Plan { plan: Plan, line: String },
+    /// The current take's tokens decoded with a new plan (a named posture laid on it, a path
+    /// drawn for a segment); `line` says what changed, `edit` is what the take's history
+    /// records of it, if anything.
+    Plan {
+        plan: Plan,
+        line: String,
+        edit: Option<Edit>,
+    },
 }
 
 /// State every component reads through context.
@@ -234,16 +239,17 @@ fn on_reply(state: AppState, reply: Reply) {
                     }
                     None => return state.fail("there was no motion to edit"),
                 },
-                Some(Pending::Plan { plan, .. }) => match state.take() {
+                Some(Pending::Plan { plan, edit, .. }) => match state.take() {
                     Some(mut take) => {
                         take.segments = crate::take::plan_segments(&plan, motion.joints.len());
                         take.plan = Some(plan);
                         take.motion = motion;
-                        // The review scored the motion before the posture.
+                        take.edits.extend(edit);
+                        // The review scored the motion before the change.
                         take.scores.clear();
                         take
                     }
-                    None => return state.fail("there was no motion to lay the posture on"),
+                    None => return state.fail("there was no motion to change"),
                 },
                 Some(Pending::Link(link)) => {
                     let (plan, legacy) =

@@ -9,6 +9,8 @@ use coma::session::Motion;
 use coma::share::{Edit, EditKind, LinkPlan, LinkSegment, RunRecord, SegmentScores, SharedMotion};
 use coma::skeleton::BodyPart;
 use coma::timing::{frames_for_seconds, seconds, FPS, FRAMES_PER_TOKEN};
+use coma::trajectory::drawn::{thin, MIN_DRAWN_STEP_M};
+use coma::trajectory::{check_drawn, path_length, MapOptions, Trajectory, MAX_DRAWN_POINTS};
 
 /// A stretch of the motion with its own text, in frames at 20 fps, and what the plan asked
 /// of it.
@@ -343,6 +345,119 @@ pub fn with_posture(
     })
 }
 
+/// A path drawn on the ground laid on a segment of a take: the plan to decode the take's
+/// tokens with (the segment's trajectory is the drawn path), the history's edit, and what
+/// the user is told.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathEdit {
+    pub plan: Plan,
+    /// The plan segment that walks the path.
+    pub segment: usize,
+    /// Its frames (20 fps, from the start of the take).
+    pub from: usize,
+    pub to: usize,
+    /// The drawn path as the plan carries it (thinned, rounded to the millimetre).
+    pub trajectory: Trajectory,
+    /// Length of the drawn line, metres.
+    pub drawn_m: f64,
+    /// Length the engine gives the path on the segment (see
+    /// [`coma::trajectory::path_length`]), metres; `None` when the take has no features to
+    /// measure (the engine still scales it, the message just cannot say to what).
+    pub walk_m: Option<f64>,
+    /// The segment barely moves, so the path is walked at the default walking speed.
+    pub default_speed: bool,
+    /// The path the segment had before (which the drawn one replaces), described.
+    pub replaced: Option<String>,
+    /// Segments in the plan, for naming the segment only when there are several.
+    pub segments: usize,
+}
+
+impl PathEdit {
+    /// What happened, for the status line: the drawn length, what it was scaled to and why.
+    pub fn line(&self) -> String {
+        let mut line = format!("path drawn: {:.1} m", self.drawn_m);
+        match self.walk_m {
+            Some(walk) if self.default_speed => line.push_str(&format!(
+                ", walked at an even pace over {walk:.1} m (the motion barely moves on its own)"
+            )),
+            Some(walk) => line.push_str(&format!(", scaled to the walk's {walk:.1} m")),
+            None => line.push_str(", scaled to the distance the motion walks"),
+        }
+        if self.segments > 1 {
+            line.push_str(&format!(" in segment {}", self.segment + 1));
+        }
+        if let Some(old) = &self.replaced {
+            line.push_str(&format!(", in place of {old}"));
+        }
+        line
+    }
+
+    /// The history's record of the edit (a link carries it; the plan carries the points).
+    pub fn edit(&self, seed: u64) -> Edit {
+        Edit {
+            kind: EditKind::Trajectory,
+            text: self.trajectory.describe(),
+            from_frame: self.from as u32,
+            to_frame: self.to as u32,
+            parts: 0,
+            seed,
+        }
+    }
+}
+
+/// The plan of `take` with segment `segment` walking `stroke`, the points drawn on the
+/// ground (`[x, z]` metres, Y up, the motion starting at the origin facing +Z): thinned to
+/// at most [`MAX_DRAWN_POINTS`] points a couple of centimetres apart and checked as a plan's
+/// path is. The engine lays it as it lays a typed path: from where the segment starts, turned
+/// to its heading there, scaled to the distance it travels. A take without a plan (an older
+/// link) cannot take one.
+pub fn with_drawn_path(
+    take: &Take,
+    segment: usize,
+    stroke: &[[f64; 2]],
+) -> Result<PathEdit, String> {
+    let Some(mut plan) = take.plan.clone() else {
+        return Err(
+            "This motion came from an older link without a plan: generate it again to draw its path."
+                .into(),
+        );
+    };
+    let ranges = coma::agents::pipeline::segment_ranges(&plan, &take.motion.tokens);
+    let Some(range) = ranges.get(segment).filter(|r| !r.is_empty()).cloned() else {
+        return Err(format!(
+            "There is no segment {} to draw a path for.",
+            segment + 1
+        ));
+    };
+    let points = thin(stroke, MIN_DRAWN_STEP_M, MAX_DRAWN_POINTS);
+    let drawn_m =
+        check_drawn(&points).map_err(|e| format!("No path laid: {e}. The motion is unchanged."))?;
+    let trajectory = Trajectory::Points { points };
+    trajectory
+        .validate()
+        .map_err(|e| format!("No path laid: {e}. The motion is unchanged."))?;
+    let rows = take.motion.features.get(range.clone());
+    let length = rows
+        .filter(|r| r.len() >= 2)
+        .map(|r| path_length(r, &MapOptions::default()));
+    let replaced = plan.segments[segment]
+        .trajectory
+        .replace(trajectory.clone())
+        .map(|t| t.describe());
+    Ok(PathEdit {
+        segments: plan.segments.len(),
+        plan,
+        segment,
+        from: range.start,
+        to: range.end,
+        trajectory,
+        drawn_m,
+        walk_m: length.map(|l| l.length_m),
+        default_speed: length.is_some_and(|l| l.slow),
+        replaced,
+    })
+}
+
 /// One line for an edit of the history, as the Steps panel lists it.
 pub fn edit_line(edit: &Edit) -> String {
     let span = format!(
@@ -519,6 +634,120 @@ mod tests {
         let mut old = take.clone();
         old.plan = None;
         assert!(with_posture(&old, &t_pose(), arms, 0, 50).is_err());
+    }
+
+    /// A take of the three-segment plan, walking 0.05 m a frame (1 m/s).
+    fn walking_take() -> Take {
+        let plan = coma::agents::planner::offline::plan(
+            "A person walks forward waving the left hand, then turns right and bows",
+            None,
+        );
+        let tokens = coma::model::tokens::MotionTokens::new(vec![vec![vec![0; 60]; 1]; 4]).unwrap();
+        let mut row = [0f32; coma::features::FEATURE_DIM];
+        row[2] = 0.05;
+        let motion = Motion {
+            tokens,
+            joints: vec![[[0.0; 3]; 22]; 240],
+            features: vec![row; 240],
+        };
+        Take::new(motion, "p".into(), 4, Vec::new(), Some(plan), Vec::new())
+    }
+
+    #[test]
+    fn a_drawn_path_goes_into_its_segment_and_says_how_it_was_scaled() {
+        let take = walking_take();
+        // An L drawn every centimetre: 2 m forward, 1 m to the right.
+        let mut stroke: Vec<[f64; 2]> = (0..=200).map(|i| [0.0, 0.01 * i as f64]).collect();
+        stroke.extend((1..=100).map(|i| [-0.01 * i as f64, 2.0]));
+        let edit = with_drawn_path(&take, 1, &stroke).unwrap();
+        assert_eq!((edit.segment, edit.from, edit.to), (1, 80, 180));
+        let Trajectory::Points { points } = &edit.trajectory else {
+            panic!("{:?}", edit.trajectory)
+        };
+        assert!(points.len() < 200 && points.len() > 100, "{}", points.len());
+        assert_eq!(
+            edit.plan.segments[1].trajectory.as_ref(),
+            Some(&edit.trajectory)
+        );
+        assert_eq!(
+            edit.plan.segments[0],
+            take.plan.as_ref().unwrap().segments[0]
+        );
+        assert!((edit.drawn_m - 3.0).abs() < 0.01, "{}", edit.drawn_m);
+        // 99 steps of 5 cm in the segment's frames.
+        assert!(
+            (edit.walk_m.unwrap() - 4.95).abs() < 1e-4,
+            "{:?}",
+            edit.walk_m
+        );
+        assert!(!edit.default_speed);
+        assert_eq!(
+            edit.line(),
+            "path drawn: 3.0 m, scaled to the walk's 5.0 m in segment 2"
+        );
+        let record = edit.edit(9);
+        assert_eq!(record.kind, EditKind::Trajectory);
+        assert_eq!(
+            edit_line(&record),
+            format!(
+                "path \"a drawn path (3.0 m, {} points)\" (4.0–9.0 s)",
+                points.len()
+            )
+        );
+        // The plan as a link carries it reads back the same, points and all.
+        let link = coma::share::decode(&coma::share::encode(
+            &Take {
+                plan: Some(edit.plan.clone()),
+                ..take.clone()
+            }
+            .shared([1; 8]),
+        ))
+        .unwrap();
+        assert_eq!(link.plan.plan(), Some(&edit.plan));
+        // Drawn again on the same segment: the new path replaces the old one.
+        let mut again = take.clone();
+        again.plan = Some(edit.plan.clone());
+        let second = with_drawn_path(&again, 1, &stroke[..150]).unwrap();
+        assert_eq!(
+            second.replaced.as_deref(),
+            Some(edit.trajectory.describe().as_str())
+        );
+        assert!(second.line().contains("in place of a drawn path (3.0 m"));
+    }
+
+    #[test]
+    fn strokes_that_are_no_path_leave_a_clear_message() {
+        let take = walking_take();
+        let short = with_drawn_path(&take, 0, &[[0.0, 0.0], [0.1, 0.1]]).unwrap_err();
+        assert!(
+            short.contains("too short") && short.contains("unchanged"),
+            "{short}"
+        );
+        let click = with_drawn_path(&take, 0, &[[1.0, 1.0], [1.001, 1.0]]).unwrap_err();
+        assert!(click.contains("at least 2 points"), "{click}");
+        assert!(with_drawn_path(&take, 0, &[]).is_err());
+        let far = with_drawn_path(&take, 0, &[[0.0, 0.0], [0.0, 500.0]]).unwrap_err();
+        assert!(far.contains("beyond"), "{far}");
+        assert!(with_drawn_path(&take, 7, &[[0.0, 0.0], [0.0, 1.0]])
+            .unwrap_err()
+            .contains("no segment 8"));
+        let mut old = take.clone();
+        old.plan = None;
+        assert!(with_drawn_path(&old, 0, &[[0.0, 0.0], [0.0, 1.0]])
+            .unwrap_err()
+            .contains("older link"));
+        // A motion that stands still walks the path at the default speed, and says so.
+        let mut still = take.clone();
+        for row in &mut still.motion.features {
+            row[2] = 0.0;
+        }
+        let edit = with_drawn_path(&still, 0, &[[0.0, 0.0], [0.0, 1.0]]).unwrap();
+        assert!(edit.default_speed);
+        assert!(
+            edit.line().contains("even pace over 4.7 m"),
+            "{}",
+            edit.line()
+        );
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //!
 //! The pipeline (design §5): a path is a curve `x(t)`, `z(t)` on the ground plane, either a
 //! built-in [`Shape`] recognised in the prompt or formulas written by the LLM, both evaluated
-//! by the sandboxed [`expr`] language. [`path`] samples it, fits a B-spline, reparametrises it
+//! by the sandboxed [`expr`] language, or points drawn with the pointer on the page's ground
+//! plane ([`drawn`]). [`path`] samples a curve, fits a B-spline, reparametrises it
 //! by arc length and scales it to the motion's own travelled distance; [`root`] rewrites the
 //! root features (angular and linear velocity) so that the rebuilt joints walk it, keeping the
 //! local pose; [`check`] measures the result, and
@@ -13,6 +14,7 @@
 //! towards −X.
 
 pub mod check;
+pub mod drawn;
 pub mod expr;
 pub mod path;
 pub mod root;
@@ -23,15 +25,18 @@ use serde::{Deserialize, Serialize};
 use crate::features::{FeatureFrame, Features};
 
 pub use check::{circle_report, CircleReport};
+pub use drawn::{check_drawn, DrawnError, MAX_DRAWN_COORD_M, MAX_DRAWN_POINTS, MIN_DRAWN_LENGTH_M};
 pub use path::{ArcPath, Path, PathError};
-pub use root::{map_curve, map_path, root_path, MapOptions, MapReport, RootError};
+pub use root::{
+    map_curve, map_path, path_length, root_path, MapOptions, MapReport, PathLength, RootError,
+};
 pub use shapes::{Curve, CurveError, CurveSpec, Shape, Side};
 
-/// A path request as the planner stores it in a plan: a named built-in shape, or a curve the
-/// LLM wrote. Serialised with a `type` tag:
-/// `{"type": "shape", "shape": "circle_right"}` or
+/// A path request as a plan stores it: a named built-in shape, a curve the LLM wrote, or
+/// points the user drew. Serialised with a `type` tag:
+/// `{"type": "shape", "shape": "circle_right"}`,
 /// `{"type": "curve", "x": "sin(t)", "z": "t", "t0": 0, "t1": 6.28}` (`y` is accepted for
-/// `z`; both are ground-plane axes).
+/// `z`; both are ground-plane axes) or `{"type": "points", "points": [[0, 0], [0.5, 1.2]]}`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Trajectory {
@@ -42,6 +47,16 @@ pub enum Trajectory {
     },
     /// Formulas in `t` (arbitrary units; rescaled to the motion).
     Curve(CurveSpec),
+    /// A path drawn with the pointer: `[x, z]` ground-plane points in metres in drawing
+    /// order (Y up; the motion starts at the origin facing +Z, +X is the walker's left), 2 to
+    /// [`MAX_DRAWN_POINTS`] of them, each coordinate within ±[`MAX_DRAWN_COORD_M`] m, at
+    /// least [`MIN_DRAWN_LENGTH_M`] long (see [`drawn`]). Like every path it is walked from
+    /// where its segment starts, turned to the heading the walker has there, and scaled to
+    /// the distance the motion travels (see [`root`]): what is kept is its shape.
+    Points {
+        /// The drawn points, metres.
+        points: Vec<[f64; 2]>,
+    },
 }
 
 /// Why a trajectory request cannot be used.
@@ -56,6 +71,12 @@ pub enum TrajectoryError {
     /// The path could not be mapped onto the motion.
     #[error(transparent)]
     Root(#[from] RootError),
+    /// Drawn points that are not a path (too few, too many, too short, out of range).
+    #[error(transparent)]
+    Drawn(#[from] DrawnError),
+    /// [`Trajectory::curve`] of a drawn path, which has points, not formulas.
+    #[error("a drawn path is points, not a curve")]
+    NotACurve,
 }
 
 impl Trajectory {
@@ -64,28 +85,43 @@ impl Trajectory {
         Shape::parse(text).map(|shape| Trajectory::Shape { shape })
     }
 
-    /// The compiled curve, without checking that it is walkable.
+    /// The compiled curve of a shape or formulas, without checking that it is walkable; a
+    /// drawn path has none ([`TrajectoryError::NotACurve`]).
     pub fn curve(&self) -> Result<Curve, TrajectoryError> {
         match self {
             Trajectory::Shape { shape } => Ok(shape.curve()),
             Trajectory::Curve(spec) => Ok(spec.compile()?),
+            Trajectory::Points { .. } => Err(TrajectoryError::NotACurve),
         }
     }
 
     /// Checks everything that can be checked without a motion: the formulas parse within the
     /// sandbox's limits, the range is sane, every sample is finite and within range, and the
-    /// path has a length. Returns the walkable path (in the curve's own units).
+    /// path has a length; drawn points pass [`check_drawn`]. Returns the walkable path (in
+    /// the curve's own units; metres for drawn points).
     pub fn validate(&self) -> Result<ArcPath, TrajectoryError> {
-        Ok(ArcPath::from_curve(&self.curve()?)?)
+        match self {
+            Trajectory::Points { points } => {
+                check_drawn(points)?;
+                Ok(ArcPath::from_points(points)?)
+            }
+            _ => Ok(ArcPath::from_curve(&self.curve()?)?),
+        }
     }
 
-    /// A short description for messages, e.g. "a circle, clockwise" or "the curve x = …".
+    /// A short description for messages, e.g. "a circle, clockwise", "the curve x = …" or
+    /// "a drawn path (4.2 m, 40 points)".
     pub fn describe(&self) -> String {
         match self {
             Trajectory::Shape { shape } => shape.describe(),
             Trajectory::Curve(c) => format!(
                 "the curve x = {}, z = {} for t from {} to {}",
                 c.x, c.z, c.t0, c.t1
+            ),
+            Trajectory::Points { points } => format!(
+                "a drawn path ({:.1} m, {} points)",
+                drawn::polyline_length(points),
+                points.len()
             ),
         }
     }
@@ -245,6 +281,90 @@ mod tests {
         for shape in Shape::ALL {
             assert!(Trajectory::Shape { shape }.validate().is_ok(), "{shape:?}");
         }
+    }
+
+    #[test]
+    fn drawn_paths_serialise_and_are_checked_as_data() {
+        let t = Trajectory::Points {
+            points: vec![[0.0, 0.0], [0.0, 1.5], [1.25, 1.5]],
+        };
+        let json = serde_json::to_string(&t).unwrap();
+        assert_eq!(
+            json,
+            r#"{"type":"points","points":[[0.0,0.0],[0.0,1.5],[1.25,1.5]]}"#
+        );
+        assert_eq!(serde_json::from_str::<Trajectory>(&json).unwrap(), t);
+        assert_eq!(t.describe(), "a drawn path (2.8 m, 3 points)");
+        // Three points are three spline control points: the corner is cut, never lengthened.
+        let length = t.validate().unwrap().length();
+        assert!((1.95..=2.75).contains(&length), "{length}");
+        assert_eq!(t.curve(), Err(TrajectoryError::NotACurve));
+
+        let points = |points: Vec<[f64; 2]>| Trajectory::Points { points };
+        let err = |t: Trajectory| t.validate().unwrap_err();
+        assert_eq!(
+            err(points(vec![[0.0, 0.0]])),
+            TrajectoryError::Drawn(DrawnError::TooFewPoints(1))
+        );
+        assert_eq!(
+            err(points(vec![[0.0, 0.0]; MAX_DRAWN_POINTS + 1])),
+            TrajectoryError::Drawn(DrawnError::TooManyPoints(MAX_DRAWN_POINTS + 1))
+        );
+        assert_eq!(
+            err(points(vec![[0.0, 0.0], [0.0, 1.0], [1e9, 1.0]])),
+            TrajectoryError::Drawn(DrawnError::OutOfRange {
+                index: 2,
+                value: 1e9
+            })
+        );
+        let short = err(points(vec![[0.0, 0.0], [0.1, 0.1]]));
+        assert!(matches!(
+            short,
+            TrajectoryError::Drawn(DrawnError::TooShort { .. })
+        ));
+        assert!(short.to_string().contains("too short"), "{short}");
+        // A doctored link's JSON: NaN does not parse as a number, so it is refused there.
+        assert!(
+            serde_json::from_str::<Trajectory>(r#"{"type":"points","points":[[0,0],[1]]}"#)
+                .is_err()
+        );
+    }
+
+    #[test]
+    fn a_drawn_line_and_an_l_shape_are_walked() {
+        // Drawn anywhere, in any direction: the walk starts where it is, heading along the
+        // first stroke, and walks the stroke's shape scaled to its own distance.
+        let f = test_motion::walk(81, 1.2, 0.0);
+        let line = Trajectory::Points {
+            points: (0..20).map(|i| [2.0 + 0.1 * i as f64, -1.0]).collect(),
+        };
+        let (mapped, report) = apply(&f, &line, &MapOptions::default()).unwrap();
+        let root = root_path(&mapped);
+        assert!((report.path_length_m - 4.8).abs() < 0.05, "{report:?}");
+        assert!(report.net_turn_deg.abs() < 2.0, "{report:?}");
+        for p in &root {
+            assert!(p[0].abs() < 0.06, "{p:?}");
+        }
+        assert!((root[80][1] - 4.8).abs() < 0.1, "{:?}", root[80]);
+
+        // An L: 2 m forward, then 2 m to the walker's right (−X), drawn from the origin.
+        let mut points: Vec<[f64; 2]> = (0..=20).map(|i| [0.0, 0.1 * i as f64]).collect();
+        points.extend((1..=20).map(|i| [-0.1 * i as f64, 2.0]));
+        let l_shape = Trajectory::Points { points };
+        let (mapped, report) = apply(&f, &l_shape, &MapOptions::default()).unwrap();
+        let root = root_path(&mapped);
+        // 4.8 m walked over 4 m drawn: every distance grows by 1.2.
+        let corner = root[40];
+        assert!(
+            corner[0].abs() < 0.25 && (corner[1] - 2.4).abs() < 0.25,
+            "{corner:?}"
+        );
+        let end = root[80];
+        assert!(
+            (end[0] + 2.4).abs() < 0.15 && (end[1] - 2.4).abs() < 0.15,
+            "{end:?}"
+        );
+        assert!((report.net_turn_deg + 90.0).abs() < 10.0, "{report:?}");
     }
 
     #[test]

@@ -129,6 +129,60 @@ pub enum RootError {
     Path(#[from] PathError),
 }
 
+/// The length a path is given on a motion, as [`map_path`] chooses it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathLength {
+    /// The path's length once laid, metres.
+    pub length_m: f64,
+    /// Distance the motion's root travels over its displayed frames, metres.
+    pub source_distance_m: f64,
+    /// Duration from the first to the last displayed frame, seconds.
+    pub duration_s: f64,
+    /// Whether the motion barely moves, so the path is walked at
+    /// [`MapOptions::default_speed_m_s`] (unless [`MapOptions::length_m`] sets the length).
+    pub slow: bool,
+}
+
+/// The root's step on the ground per row, metres (the last row's leads past the end).
+fn root_steps(features: &[FeatureFrame]) -> Vec<f64> {
+    features
+        .iter()
+        .map(|r| (r[1] as f64).hypot(r[2] as f64))
+        .collect()
+}
+
+/// How long a path laid on `features` (raw rows at 20 fps) by [`map_path`] with `options`
+/// is: [`MapOptions::length_m`] if set, else the distance the motion travels, else (for a
+/// motion that barely moves) the default speed times its duration. The page says this to
+/// the user before the engine lays a drawn path. Fewer than two rows travel nothing in no
+/// time.
+pub fn path_length(features: &[FeatureFrame], options: &MapOptions) -> PathLength {
+    // Steps between the displayed frames (features_to_joints gives one pose per row); the
+    // last row's step leads past the end, to the pose `features_to_joints_with_final` adds.
+    let step = root_steps(features);
+    let shown = &step[..step.len().saturating_sub(1)];
+    let source_distance: f64 = shown.iter().sum();
+    let duration = features.len().saturating_sub(1) as f64 / FPS;
+    let source_speed = if duration > 0.0 {
+        source_distance / duration
+    } else {
+        0.0
+    };
+    // A motion with no travel at all has no profile to follow even if the threshold is 0.
+    let slow = source_speed < options.min_mean_speed_m_s || source_distance <= 1e-9;
+    let length = match options.length_m {
+        Some(l) => l,
+        None if slow => options.default_speed_m_s * duration,
+        None => source_distance,
+    };
+    PathLength {
+        length_m: length,
+        source_distance_m: source_distance,
+        duration_s: duration,
+        slow,
+    }
+}
+
 /// Rewrites the root of `features` so the motion walks `curve` (see the module
 /// documentation).
 pub fn map_curve(
@@ -158,24 +212,14 @@ pub fn map_path(
         return Err(RootError::NonFinite(r));
     }
 
-    // Steps between the `rows` displayed frames (features_to_joints gives one pose per row);
-    // the last row's step leads past the end, to the pose `features_to_joints_with_final`
-    // adds.
-    let step: Vec<f64> = features
-        .iter()
-        .map(|r| (r[1] as f64).hypot(r[2] as f64))
-        .collect();
-    let shown = &step[..rows - 1];
-    let source_distance: f64 = shown.iter().sum();
-    let duration = (rows - 1) as f64 / FPS;
+    let step = root_steps(features);
+    let PathLength {
+        length_m: length,
+        source_distance_m: source_distance,
+        duration_s: duration,
+        slow,
+    } = path_length(features, options);
     let source_speed = source_distance / duration;
-    // A motion with no travel at all has no profile to follow even if the threshold is 0.
-    let slow = source_speed < options.min_mean_speed_m_s || source_distance <= 1e-9;
-    let length = match options.length_m {
-        Some(l) => l,
-        None if slow => options.default_speed_m_s * duration,
-        None => source_distance,
-    };
     let scaled = path.scaled_to(length)?;
     let weight = |k: usize| if slow { 1.0 } else { step[k] };
     let total_weight: f64 = (0..rows - 1).map(weight).sum();

@@ -117,6 +117,7 @@ pub fn PosturePicker(
                     Pending::Plan {
                         plan: edit.plan,
                         line,
+                        edit: None,
                     },
                 );
             }

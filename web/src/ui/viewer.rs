@@ -1,10 +1,13 @@
-//! The 3D viewer: the canvas with the WebGPU renderer, orbit (drag) and zoom (wheel), and the
-//! playback controls (play/pause, scrub, speed). The canvas follows its box's size.
+//! The 3D viewer: the canvas with the WebGPU renderer, orbit (drag) and zoom (wheel), the
+//! playback controls (play/pause, scrub, speed) and drawing a path on the ground (see
+//! [`super::path_draw`]: in draw mode a drag draws instead of orbiting). The canvas follows
+//! its box's size.
 
+use super::path_draw::{PathDraw, Pen};
 use crate::app::AppState;
 use crate::take::joints_hash;
 use crate::viewer::gpu::{Frame, Renderer};
-use crate::viewer::scene::{grid_lines, path_lines, skeleton_triangles, OrbitCamera};
+use crate::viewer::scene::{grid_lines, path_lines, skeleton_triangles, stroke_lines, OrbitCamera};
 use leptos::html::Canvas;
 use leptos::prelude::*;
 use std::cell::RefCell;
@@ -20,6 +23,7 @@ fn tick(
     canvas: &web_sys::HtmlCanvasElement,
     renderer: &mut Renderer,
     camera: &mut OrbitCamera,
+    stroke: RwSignal<Vec<[f64; 2]>>,
     dt: f64,
 ) {
     let ratio = crate::browser::device_pixel_ratio();
@@ -55,6 +59,7 @@ fn tick(
             triangles = skeleton_triangles(pose, camera);
             lines.extend(path_lines(&take.motion.joints));
         }
+        stroke.with_untracked(|s| lines.extend(stroke_lines(s)));
         let drawn = renderer.draw(&Frame {
             view_projection: camera.view_projection(renderer.aspect()),
             triangles: &triangles,
@@ -79,6 +84,7 @@ fn animate(
     canvas: web_sys::HtmlCanvasElement,
     mut renderer: Renderer,
     camera: StoredValue<OrbitCamera>,
+    stroke: RwSignal<Vec<[f64; 2]>>,
 ) {
     type Step = Closure<dyn FnMut(f64)>;
     let step: Rc<RefCell<Option<Step>>> = Rc::new(RefCell::new(None));
@@ -88,7 +94,7 @@ fn animate(
         let dt = last.map_or(0.0, |l| ((now - l) / 1000.0).clamp(0.0, 0.25));
         last = Some(now);
         let mut cam = camera.get_value();
-        tick(state, &canvas, &mut renderer, &mut cam, dt);
+        tick(state, &canvas, &mut renderer, &mut cam, stroke, dt);
         camera.set_value(cam);
         if let (Some(w), Some(f)) = (web_sys::window(), again.borrow().as_ref()) {
             let _ = w.request_animation_frame(f.as_ref().unchecked_ref());
@@ -107,6 +113,20 @@ pub fn Viewer() -> impl IntoView {
     let camera = StoredValue::new(OrbitCamera::default());
     let drag = StoredValue::new(None::<(i32, i32)>);
     let problem = RwSignal::new(None::<String>);
+    let pen = Pen::default();
+    // The ground point under the pointer, through the camera as the last frame drew it.
+    let ground = move |ev: &web_sys::PointerEvent| {
+        let c = canvas.get_untracked()?;
+        let (w, h) = (
+            c.client_width().max(1) as f32,
+            c.client_height().max(1) as f32,
+        );
+        let ndc = [
+            2.0 * ev.offset_x() as f32 / w - 1.0,
+            1.0 - 2.0 * ev.offset_y() as f32 / h,
+        ];
+        camera.get_value().ground_point(ndc, w / h)
+    };
     canvas.on_load(move |element| {
         if !crate::browser::has_webgpu() {
             problem.set(Some(
@@ -116,7 +136,7 @@ pub fn Viewer() -> impl IntoView {
         }
         leptos::task::spawn_local(async move {
             match Renderer::new(element.clone()).await {
-                Ok(renderer) => animate(state, element, renderer, camera),
+                Ok(renderer) => animate(state, element, renderer, camera, pen.stroke),
                 Err(e) => problem.set(Some(format!("The 3D view is off: {e}."))),
             }
         });
@@ -137,21 +157,38 @@ pub fn Viewer() -> impl IntoView {
             <canvas
                 id="view"
                 node_ref=canvas
+                class:drawing=move || pen.on.get()
                 on:pointerdown=move |ev: web_sys::PointerEvent| {
-                    drag.set_value(Some((ev.client_x(), ev.client_y())));
                     if let Some(c) = canvas.get_untracked() {
                         let _ = c.set_pointer_capture(ev.pointer_id());
                     }
+                    // In draw mode a drag draws; the camera holds still under the pen.
+                    if pen.on.get_untracked() {
+                        ev.prevent_default();
+                        pen.press(ground(&ev));
+                    } else {
+                        drag.set_value(Some((ev.client_x(), ev.client_y())));
+                    }
                 }
                 on:pointermove=move |ev: web_sys::PointerEvent| {
-                    if let Some((x, y)) = drag.get_value() {
+                    if pen.down.get_untracked() {
+                        pen.drag(ground(&ev));
+                    } else if let Some((x, y)) = drag.get_value() {
                         let (dx, dy) = (ev.client_x() - x, ev.client_y() - y);
                         camera.update_value(|c| c.orbit(-dx as f32 * 0.01, dy as f32 * 0.01));
                         drag.set_value(Some((ev.client_x(), ev.client_y())));
                     }
                 }
-                on:pointerup=move |_| drag.set_value(None)
-                on:pointercancel=move |_| drag.set_value(None)
+                on:pointerup=move |_| {
+                    drag.set_value(None);
+                    pen.release(state);
+                }
+                on:pointercancel=move |_| {
+                    drag.set_value(None);
+                    // The browser took the pointer (a scroll, a lost touch): no path from that.
+                    pen.down.set(false);
+                    pen.stroke.set(Vec::new());
+                }
                 on:wheel=move |ev: web_sys::WheelEvent| {
                     ev.prevent_default();
                     camera.update_value(|c| c.zoom((ev.delta_y() * 0.001).exp() as f32));
@@ -197,6 +234,7 @@ pub fn Viewer() -> impl IntoView {
                     <option value="2">"2×"</option>
                 </select>
             </div>
+            <PathDraw pen/>
         </div>
     }
 }

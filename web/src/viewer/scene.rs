@@ -136,6 +136,36 @@ impl OrbitCamera {
         multiply(&projection, &view)
     }
 
+    /// The point of the ground (the plane y = 0) under a point of the picture, as `[x, z]`
+    /// metres, or `None` where the picture shows sky (or ground beyond the far plane).
+    /// `ndc` is the picture point in normalised device coordinates: x from −1 (left edge) to
+    /// 1 (right), y from −1 (bottom) to 1 (top); `aspect` = width / height as given to
+    /// [`OrbitCamera::view_projection`], whose inverse this is on that plane.
+    pub fn ground_point(&self, ndc: [f32; 2], aspect: f32) -> Option<[f32; 2]> {
+        let aspect = if aspect.is_finite() && aspect > 0.0 {
+            aspect
+        } else {
+            1.0
+        };
+        let eye = self.eye();
+        let f = normalize(sub(self.target, eye));
+        let (s, u) = self.axes();
+        // A picture point at NDC (x, y) lies along f + x·tan(fov/2)·aspect·s + y·tan(fov/2)·u
+        // (the projection's t = 1/tan(fov/2) divides them back out).
+        let h = (self.fov / 2.0).tan();
+        let ray = add(f, add(scale(s, ndc[0] * h * aspect), scale(u, ndc[1] * h)));
+        // Rays level with the horizon or above it (or NaN) never meet the ground in front.
+        if ray[1].is_nan() || ray[1] >= -1e-6 {
+            return None;
+        }
+        let t = -eye[1] / ray[1];
+        let hit = add(eye, scale(ray, t));
+        // Beyond the far plane the picture shows nothing, so nothing can be pointed at there.
+        let along = t * dot(ray, f);
+        (t > 0.0 && along < 100.0 && hit[0].is_finite() && hit[2].is_finite())
+            .then_some([hit[0], hit[2]])
+    }
+
     /// The camera's right and up directions in world space (for billboards).
     fn axes(&self) -> (V3, V3) {
         let f = normalize(sub(self.target, self.eye()));
@@ -255,6 +285,21 @@ pub fn path_lines(poses: &[[V3; 22]]) -> Vec<Vertex> {
         .collect()
 }
 
+/// Line segments of a path being drawn on the ground (`[x, z]` metres), just above the root's
+/// path so it shows over it, in a warm colour apart from the path's blue.
+pub fn stroke_lines(points: &[[f64; 2]]) -> Vec<Vertex> {
+    let color = [0.85, 0.33, 0.1, 1.0];
+    points
+        .windows(2)
+        .flat_map(|w| {
+            [w[0], w[1]].map(|p| Vertex {
+                position: [p[0] as f32, 0.006, p[1] as f32],
+                color,
+            })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -326,10 +371,51 @@ mod tests {
     }
 
     #[test]
+    fn a_picked_ground_point_projects_back_to_where_it_was_picked() {
+        for camera in [
+            OrbitCamera::default(),
+            OrbitCamera {
+                target: [1.5, 0.9, -2.0],
+                yaw: 2.4,
+                pitch: 1.2,
+                distance: 7.0,
+                ..OrbitCamera::default()
+            },
+        ] {
+            let aspect = 16.0 / 10.0;
+            let m = camera.view_projection(aspect);
+            for ground in [[0.0, 0.0], [0.7, -0.4], [1.5, -2.0], [2.0, 1.0]] {
+                let ndc = clip_to_ndc(project(&m, [ground[0], 0.0, ground[1]]));
+                let picked = camera.ground_point([ndc[0], ndc[1]], aspect).unwrap();
+                assert!(
+                    (picked[0] - ground[0]).abs() < 1e-3 && (picked[1] - ground[1]).abs() < 1e-3,
+                    "{camera:?}: {ground:?} picked as {picked:?}"
+                );
+            }
+        }
+        // Level with the camera, from just above the ground: the top of the picture is sky.
+        let low = OrbitCamera {
+            pitch: 0.0,
+            ..OrbitCamera::default()
+        };
+        assert_eq!(low.ground_point([0.0, 0.9], 1.0), None);
+        // The bottom of the default view is ground in front of the character, towards the
+        // camera (which looks from +X, +Z).
+        let below = OrbitCamera::default()
+            .ground_point([0.0, -0.9], 1.0)
+            .unwrap();
+        assert!(below[0] > 0.0 && below[1] > 0.0, "{below:?}");
+    }
+
+    #[test]
     fn grid_and_path() {
         assert_eq!(grid_lines([0.0, 0.0], 2.0, 0.5).len(), 9 * 4);
         let poses = vec![[[0.0f32; 3]; 22]; 5];
         assert_eq!(path_lines(&poses).len(), 8);
         assert!(path_lines(&poses[..1]).is_empty());
+        let stroke = stroke_lines(&[[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]]);
+        assert_eq!(stroke.len(), 4);
+        assert_eq!(stroke[3].position, [1.0, 0.006, 1.0]);
+        assert!(stroke_lines(&[[0.0, 0.0]]).is_empty());
     }
 }
