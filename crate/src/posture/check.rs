@@ -4,7 +4,7 @@
 //! or a pose, never a panic, a broken joint limit or a joint under the floor.
 
 use super::script::{describe_pose, PostureScript};
-use super::solver::{clamp_angles, imbalance_m, pose_of, rest_angles, solve, Angles};
+use super::solver::{clamp_angles, imbalance_m, pose_of, rest_angles, solve, Angles, Solved};
 use crate::posecodes::floor_height;
 use crate::rng::Rng;
 use crate::skeleton::Pose;
@@ -40,7 +40,7 @@ impl RoundTrip {
         self.read_back as f64 / self.constraints.max(1) as f64
     }
 
-    fn add(&mut self, label: &str, script: &PostureScript, start: Option<&Angles>) -> Angles {
+    fn add(&mut self, label: &str, script: &PostureScript, start: Option<&Angles>) -> Solved {
         let solved = solve(script, start);
         self.scripts += 1;
         self.constraints += script.constraints.len();
@@ -57,7 +57,7 @@ impl RoundTrip {
                 self.misses.push(format!("{label}: {c}"));
             }
         }
-        solved.angles
+        solved
     }
 }
 
@@ -73,6 +73,59 @@ pub fn round_trip_scripts<'a>(
     }
     report.mean_ms = (now_ms() - start) / report.scripts.max(1) as f64;
     report
+}
+
+/// Each pose's solve time of a timed round trip, and the solved poses with a non-finite
+/// coordinate (should be none).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct PoseTimes {
+    /// Milliseconds per pose, in the order solved.
+    pub ms: Vec<f64>,
+    /// Solved poses with a NaN or infinite coordinate.
+    pub non_finite: usize,
+}
+
+impl PoseTimes {
+    /// Mean milliseconds per pose.
+    pub fn mean(&self) -> f64 {
+        self.ms.iter().sum::<f64>() / self.ms.len().max(1) as f64
+    }
+
+    /// Median milliseconds per pose (the mean of the middle two for an even count).
+    pub fn median(&self) -> f64 {
+        let mut sorted = self.ms.clone();
+        sorted.sort_by(f64::total_cmp);
+        match sorted.len() {
+            0 => 0.0,
+            n if n % 2 == 1 => sorted[n / 2],
+            n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+        }
+    }
+
+    /// Slowest pose, milliseconds.
+    pub fn max(&self) -> f64 {
+        self.ms.iter().copied().fold(0.0, f64::max)
+    }
+}
+
+/// As [`round_trip_scripts`], timing each pose on its own (for the solver's speed, natively and
+/// in the browser: `web/tests/posture_speed.rs`). `now_ms` is any millisecond clock.
+pub fn round_trip_timed<'a>(
+    scripts: impl IntoIterator<Item = (String, &'a PostureScript)>,
+    now_ms: &dyn Fn() -> f64,
+) -> (RoundTrip, PoseTimes) {
+    let mut report = RoundTrip::default();
+    let mut times = PoseTimes::default();
+    for (label, script) in scripts {
+        let start = now_ms();
+        let solved = report.add(&label, script, None);
+        times.ms.push(now_ms() - start);
+        if !solved.pose.iter().flatten().all(|v| v.is_finite()) {
+            times.non_finite += 1;
+        }
+    }
+    report.mean_ms = times.mean();
+    (report, times)
 }
 
 /// A random pose that stands still: angles drawn near the rest pose (or anywhere in their
@@ -118,10 +171,15 @@ pub fn random_script(rng: &mut Rng) -> PostureScript {
     .expect("constraints read off one pose agree")
 }
 
+/// `n` random valid scripts from `seed`: the ones [`round_trip_random`] solves.
+pub fn random_scripts(n: usize, seed: u64) -> Vec<PostureScript> {
+    let mut rng = Rng::new(seed);
+    (0..n).map(|_| random_script(&mut rng)).collect()
+}
+
 /// Solves `n` random valid scripts (seeded) from the rest pose and reads them back.
 pub fn round_trip_random(n: usize, seed: u64, now_ms: &dyn Fn() -> f64) -> RoundTrip {
-    let mut rng = Rng::new(seed);
-    let scripts: Vec<PostureScript> = (0..n).map(|_| random_script(&mut rng)).collect();
+    let scripts = random_scripts(n, seed);
     round_trip_scripts(
         scripts
             .iter()
