@@ -390,7 +390,8 @@ pub fn lay_postures(
         return (features.to_vec(), Vec::new());
     }
     let joints = crate::features::features_to_joints_with_final(features);
-    let (laid, notes) = lay_tracks(&joints, &spans);
+    let bridges = crate::posture::library::Library::builtin_bridges();
+    let (laid, notes) = lay_tracks(&joints, &spans, bridges);
     match crate::features::joints_to_features(&laid, &crate::skeleton::Offsets::reference()) {
         Ok((laid, _)) => (laid, notes),
         Err(e) => (

@@ -15,13 +15,16 @@
 //!   the standing feet instead of stepping forward. The facing angle is interpolated as an
 //!   angle (a 360° turn is a full spin), the ground position along a straight line, the pelvis
 //!   height so that the supports stay on the floor.
-//! - Contacts: a foot (ankle, toe) or hand (wrist) within [`CONTACT_HEIGHT`] of the floor in a
-//!   key is on the ground there. A limb on the ground in both keys at the same place stays
-//!   planted; one that must move (the body travels or turns under it) steps: it stays put,
-//!   lifts, moves and sets down inside its own window of the transition, limbs one after
-//!   another. Two-bone IK (hip–knee–ankle, shoulder–elbow–wrist) holds the targets; the pelvis
+//! - Contacts: a foot (ankle, toe) or hand (wrist) within [`contact_height`] of the floor in a
+//!   key is on the ground there; knees and the pelvis on the ground hold the body's height. A
+//!   limb on the ground in both keys at the same place stays planted; one that must move (the
+//!   body travels or turns under it) steps: it stays put, lifts, moves and sets down inside its
+//!   own window of the transition, limbs one after another. A limb that leaves the ground
+//!   carries weight through the first half of the transition, then lifts into the body's
+//!   shape. Two-bone IK (hip–knee–ankle, shoulder–elbow–wrist) holds the targets; the pelvis
 //!   sinks when a planted foot would be out of reach, and the body rises when any joint would
-//!   go under the floor.
+//!   go under the floor. With nothing on the ground in both keys, the body rests on its lowest
+//!   joint instead of floating between the keys' heights.
 //! - Jumps: a [`Transition::Flight`] key is reached by a push-off from the previous key (feet
 //!   planted, a countermovement that ends at take-off speed), a ballistic flight under
 //!   [`GRAVITY`] whose duration follows from the apex, and a landing absorbed by a short dip.
@@ -29,6 +32,7 @@
 //!   than [`MAX_JOINT_SPEED`]; flights (take-off, airborne, landing dip) are exempt.
 
 use crate::geom::{self, Quat, Vec3};
+use crate::posecodes::{FOOT_CONTACT_M, HAND_CONTACT_M, KNEE_CONTACT_M, PELVIS_CONTACT_M};
 use crate::skeleton::{
     forward_kinematics, inverse_kinematics, joint, Offsets, Pose, Rotations, NUM_JOINTS,
     REFERENCE_BONE_LENGTHS,
@@ -43,8 +47,18 @@ pub const MAX_JOINT_SPEED: f64 = 3.5;
 /// Gravitational acceleration for flights (m/s²).
 pub const GRAVITY: f64 = 9.81;
 
-/// A joint this close to the floor in a key pose (metres) is on the ground there.
-pub const CONTACT_HEIGHT: f64 = 0.05;
+/// How close to the floor (metres) a joint must be in a key pose to be on the ground there: the
+/// describer's own thresholds ([`crate::posecodes::body::Support`]), so a hand the script puts
+/// on the ground (a wrist 8 cm up, the joint sits above the palm) carries weight here too.
+/// Feet (ankle, toe) and the joints not listed take [`FOOT_CONTACT_M`].
+pub fn contact_height(j: usize) -> f64 {
+    match j {
+        joint::L_WRIST | joint::R_WRIST => HAND_CONTACT_M,
+        joint::L_KNEE | joint::R_KNEE => KNEE_CONTACT_M,
+        joint::PELVIS => PELVIS_CONTACT_M,
+        _ => FOOT_CONTACT_M,
+    }
+}
 
 /// Shortest eased transition (seconds); shorter or missing times are raised to it.
 pub const MIN_TRANSITION: f64 = 0.1;
@@ -99,6 +113,11 @@ const HINT_WEIGHT: f64 = 0.01;
 /// Width (metres) of the band below full reach in which a lifted limb approaches its reach
 /// softly (see `two_bone`).
 const SOFT_REACH: f64 = 0.03;
+/// Share of a flight (0–1) in which the body turns from its take-off shape into the landing
+/// key's.
+const FLIGHT_SHAPING: f64 = 0.6;
+/// Share of a transition (0–1) for which a hand or foot that leaves the ground stays on it.
+const LEAVE_LATE: f64 = 0.6;
 /// Headroom on the measured peak speed: samples can straddle the true peak.
 const SPEED_MARGIN: f64 = 1.05;
 
@@ -123,7 +142,7 @@ pub enum Transition {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KeyPose {
     /// The body shape: world joint positions (metres, Y up) solved at the origin facing +Z,
-    /// lowest joint on the floor. Bone directions, contacts (joints within [`CONTACT_HEIGHT`]
+    /// lowest joint on the floor. Bone directions, contacts (joints within [`contact_height`]
     /// of the floor) and, for a key with no support in common with the previous one, the
     /// pelvis's ground offset are read from it; bone lengths come from the reference skeleton,
     /// and the body is set on the floor again. A pose with a coordinate that is not finite or
@@ -328,12 +347,14 @@ enum LimbMode {
     Planted,
     /// Moves from its place in one key to its place in the next inside windows of the
     /// transition: `steps` windows of its own, interleaved with `of` limbs at position `slot`.
-    /// `stepping` when it is on the ground at both ends (so it must lift to move).
+    /// `stepping` when it is on the ground at both ends (so it must lift to move). Its windows
+    /// fill the transition after the share `wait` (0–1), where it stays at its first place.
     Moving {
         slot: usize,
         of: usize,
         steps: usize,
         stepping: bool,
+        wait: f64,
     },
     /// On the ground when a jump starts: stays until take-off.
     PushOff,
@@ -661,7 +682,8 @@ impl Timeline {
                 break;
             }
             let (rots, pelvis, local) = shape(&key.pose, &timeline.offsets);
-            let contact = local.map(|p| p[1] < CONTACT_HEIGHT);
+            let contact: [bool; NUM_JOINTS] =
+                std::array::from_fn(|j| local[j][1] < contact_height(j));
             let (yaw, ground, takeoff, turn, flight) = match timeline.keys.last() {
                 None => (0.0, [0.0; 3], [0.0; 3], 0.0, None),
                 Some(prev) => {
@@ -738,9 +760,12 @@ impl Timeline {
     /// Decides, for the transition into key `b`, which limbs stay, step or follow the body.
     fn plan(&self, b: usize) -> Plan {
         let (ka, kb) = (&self.keys[b - 1], &self.keys[b]);
+        // Knees and the pelvis carry weight too (kneeling, sitting, lying): the body's height
+        // keeps them on the floor, though only hands and feet are pinned in place.
         let supports: Vec<usize> = LIMBS
             .iter()
             .flat_map(Limb::effectors)
+            .chain([joint::L_KNEE, joint::R_KNEE, joint::PELVIS])
             .filter(|&e| ka.contact[e] && kb.contact[e])
             .collect();
         let support = |k: &Key| {
@@ -785,11 +810,15 @@ impl Timeline {
                         stride = stride.max(dist_xz(ka.world[e], kb.world[e]));
                     }
                 } else {
+                    // A hand or foot leaving the ground carries weight until the body has come
+                    // down onto its next supports (standing to sitting or lying), rather than
+                    // sliding out from under it.
                     limbs[li] = LimbMode::Moving {
                         slot: 0,
                         of: 1,
                         steps: 1,
                         stepping: false,
+                        wait: if on_a { LEAVE_LATE } else { 0.0 },
                     };
                 }
             }
@@ -811,6 +840,7 @@ impl Timeline {
                     of,
                     steps,
                     stepping: true,
+                    wait: 0.0,
                 };
             }
         }
@@ -846,6 +876,14 @@ impl Timeline {
         for p in pose.iter_mut() {
             *p = geom::add(*p, root);
         }
+        if plan.supports.is_empty() {
+            // Nothing carries the body from one key to the next (standing to lying): it rests
+            // on whatever is lowest rather than floating between the keys' heights.
+            let low = lowest(&pose) - extra;
+            if low > 0.0 {
+                shift_y(&mut pose, -low);
+            }
+        }
         pose
     }
 
@@ -854,6 +892,28 @@ impl Timeline {
         let (ka, kb) = (&self.keys[b - 1], &self.keys[b]);
         let yaw = ka.yaw + sigma * kb.turn;
         self.body(b, sigma, yaw, geom::lerp(ka.ground, kb.ground, sigma), 0.0)
+    }
+
+    /// Target of a hand or foot that leaves the ground in the transition into `b`, at `u`: it
+    /// stays where it was until `wait`, then lifts and joins the body's interpolated shape
+    /// (whose limbs are always within reach of the body, unlike a place taken from another
+    /// moment of the transition).
+    fn leaving_target(&self, b: usize, limb: &Limb, u: f64, wait: f64) -> Target {
+        let start = self.natural(b, 0.0);
+        let now = self.natural(b, geom::ease(u));
+        let r = ((u - wait) / (1.0 - wait)).clamp(0.0, 1.0);
+        let join = geom::ease(r / 0.75);
+        // Lifted while it moves, and kept up at the end only if the body holds it up there.
+        let lift = MAX_LIFT * geom::ease(r / 0.25);
+        let at = |j: usize| {
+            let p = geom::lerp(start[j], now[j], join);
+            [p[0], p[1].max(now[j][1] + lift * (1.0 - join)), p[2]]
+        };
+        Target {
+            end: at(limb.end),
+            tip: limb.tip.map(at),
+            soft: geom::ease(r / 0.25),
+        }
     }
 
     /// Target of a moving limb at `u` of the transition into `b`: pinned between its windows;
@@ -933,14 +993,9 @@ impl Timeline {
                 };
                 let mut pose = natural;
                 shift_y(&mut pose, dip + spring);
-                // If the take-off shape's feet are elsewhere, they slide there at the very end
-                // rather than jump at take-off.
-                let handover = geom::ease((u - 0.6) / 0.4);
                 for (li, limb) in LIMBS.iter().enumerate() {
                     if plan.limbs[li] == LimbMode::PushOff {
-                        let pin = |e: usize| {
-                            ka.contact[e].then(|| geom::lerp(ka.world[e], natural[e], handover))
-                        };
+                        let pin = |e: usize| ka.contact[e].then_some(ka.world[e]);
                         targets[li] = pinned(limb, pin(limb.end), limb.tip.and_then(pin), &pose);
                     }
                 }
@@ -959,11 +1014,15 @@ impl Timeline {
                             };
                             pinned(limb, pin(limb.end), limb.tip.and_then(pin), &pose)
                         }
+                        LimbMode::Moving { wait, .. } if wait > 0.0 => {
+                            Some(self.leaving_target(b, limb, u, wait))
+                        }
                         LimbMode::Moving {
                             slot,
                             of,
                             steps,
                             stepping,
+                            ..
                         } => Some(self.moving_target(b, limb, u, [slot, of, steps], stepping)),
                         _ => None,
                     };
@@ -972,6 +1031,13 @@ impl Timeline {
             }
         };
         solve(&mut pose, &targets, yaw);
+        if plan.supports.is_empty() && kb.flight.is_none() {
+            // A lifted hand or foot may have been what the body rested on.
+            let low = lowest(&pose) - dip.max(0.0);
+            if low > 0.0 {
+                shift_y(&mut pose, -low);
+            }
+        }
         pose
     }
 
@@ -982,8 +1048,14 @@ impl Timeline {
         let yaw = ka.yaw + q * kb.turn;
         let ground = geom::lerp(kb.takeoff, kb.ground, q);
         let height = kb.pelvis[1] + dip + flight.v0 * t - 0.5 * GRAVITY * t * t;
+        // The feet leave the ground where they pushed off and take the landing shape in the
+        // air (a jumping jack's legs open while airborne, not by sliding apart on the floor).
+        let mut takeoff = inverse_kinematics(&[self.ease_pose(b, 1.0, 0.0, true)], false)[0];
+        takeoff[0] = Quat::IDENTITY;
+        let mix = geom::ease(q / FLIGHT_SHAPING);
+        let rots: Rotations = std::array::from_fn(|j| takeoff[j].slerp(kb.rots[j], mix));
         let mut pose = pose_of(
-            &kb.rots,
+            &rots,
             yaw,
             root_position(ground, yaw, kb.pelvis, height),
             &self.offsets,
@@ -1450,8 +1522,8 @@ mod tests {
         // Hands and feet step one at a time: they do not drag along the floor.
         assert_eq!(foot_skating(&motion), 0.0);
         let crawl = hands_and_knees();
-        assert!(crawl[joint::L_WRIST][1] < CONTACT_HEIGHT);
-        assert!(crawl[joint::L_ANKLE][1] < CONTACT_HEIGHT);
+        assert!(crawl[joint::L_WRIST][1] < contact_height(joint::L_WRIST));
+        assert!(crawl[joint::L_ANKLE][1] < contact_height(joint::L_ANKLE));
     }
 
     #[test]

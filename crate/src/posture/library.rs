@@ -5,7 +5,8 @@
 //! model does not know (jump, spin, crawl, fall, push-ups, standing up).
 
 use super::script::{PostureScript, ScriptError};
-use super::track::{PostureTrack, TrackKey, MAX_KEYS, MAX_REPEAT};
+use super::solver::solve;
+use super::track::{Bridges, PostureTrack, TrackKey, MAX_KEYS, MAX_REPEAT};
 use crate::skeleton::BodyPart;
 use serde::Deserialize;
 use std::sync::OnceLock;
@@ -47,6 +48,9 @@ pub struct Action {
     pub returns: bool,
     /// How many times its keys play when the prompt gives no count (crawling: a few strides).
     pub repeat: u32,
+    /// How many of its first keys get into the movement and are played once, before the keys
+    /// that repeat (push-ups: into the plank once).
+    pub lead_in: u32,
     /// The key poses.
     pub keys: Vec<ActionKey>,
 }
@@ -64,9 +68,12 @@ impl Action {
     pub fn track(&self, count: Option<u32>, direction: [f64; 2]) -> PostureTrack {
         // The movement's own cycle (a few crawling strides) is one movement: its keys are
         // written out, and the track's repeat is what the prompt counts.
-        let own = (self.repeat as usize).min((MAX_KEYS / self.keys.len()).max(1));
-        let keys = std::iter::repeat_n(&self.keys, own)
-            .flatten()
+        let lead = (self.lead_in as usize).min(self.keys.len() - 1);
+        let (lead_keys, cycle) = self.keys.split_at(lead);
+        let own = (self.repeat as usize).min(((MAX_KEYS - lead) / cycle.len()).max(1));
+        let keys = lead_keys
+            .iter()
+            .chain(std::iter::repeat_n(cycle, own).flatten())
             .map(|k| {
                 let step = if k.travels { TRAVEL_STEP_M } else { 0.0 };
                 TrackKey {
@@ -85,6 +92,7 @@ impl Action {
             parts: BodyPart::ALL.to_vec(),
             keys,
             repeat: count.unwrap_or(1).clamp(1, MAX_REPEAT),
+            lead_in: lead as u32,
             returns: self.returns,
             within: None,
         }
@@ -219,6 +227,8 @@ struct ActionFile {
     returns: bool,
     #[serde(default = "one")]
     repeat: u32,
+    #[serde(default)]
+    lead_in: u32,
     keys: Vec<ActionKeyFile>,
 }
 
@@ -310,6 +320,11 @@ impl Library {
             if !(1..=MAX_REPEAT).contains(&a.repeat) {
                 return Err(fail(format!("repeat is 1 to {MAX_REPEAT}")));
             }
+            if a.lead_in as usize >= a.keys.len() {
+                return Err(fail(
+                    "the lead-in must leave at least one key to repeat".into(),
+                ));
+            }
             let mut keys = Vec::with_capacity(a.keys.len());
             for (k, key) in a.keys.iter().enumerate() {
                 let mut script = match (&key.posture, &key.constraints) {
@@ -353,6 +368,7 @@ impl Library {
                 synonyms: a.synonyms.clone(),
                 returns: a.returns,
                 repeat: a.repeat,
+                lead_in: a.lead_in,
                 keys,
             };
             // The track checks the numbers (times, turns, jumps) once, as a plan would.
@@ -392,6 +408,25 @@ impl Library {
             .iter()
             .map(Named::Posture)
             .chain(self.actions.iter().map(Named::Action))
+    }
+
+    /// The poses a posture segment passes through between standing and lying (see
+    /// [`Bridges`]): the library's "sit on the floor" and "crawling position", solved; `None`
+    /// when the library lacks either.
+    pub fn bridges(&self) -> Option<Bridges> {
+        let pose = |name: &str| Some(solve(&self.get(name)?.script, None).pose);
+        Some(Bridges {
+            back: pose("sit on the floor")?,
+            front: pose("crawling position")?,
+        })
+    }
+
+    /// The built-in library's [`Library::bridges`], solved once.
+    pub fn builtin_bridges() -> Option<&'static Bridges> {
+        static BRIDGES: OnceLock<Option<Bridges>> = OnceLock::new();
+        BRIDGES
+            .get_or_init(|| Library::builtin().bridges())
+            .as_ref()
     }
 
     /// The library shipped with the app, read once.

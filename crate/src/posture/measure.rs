@@ -208,6 +208,9 @@ pub struct RealReference {
     pub frames: usize,
     /// Mean over the motions of [`foot_skating`] (as `coma eval` averages it).
     pub skating: f64,
+    /// Share (0–1) of the real motions whose own skating is above that mean: the bar for
+    /// comparing motion by motion rather than on average.
+    pub skating_share_above: f64,
     /// 99th percentile over all frame pairs of the fastest joint's speed (m/s): the bar
     /// `coma eval`'s continuity probe uses.
     pub p99_fastest: f64,
@@ -224,7 +227,7 @@ pub fn real_reference(motions: &[Vec<Pose>]) -> RealReference {
     let mut fastest = Vec::new();
     let mut outside = Vec::new();
     let mut joints = Vec::new();
-    let mut skating = 0.0;
+    let mut per_motion = Vec::with_capacity(motions.len());
     for m in motions {
         let counted = counted_pairs(m);
         for ((_, f), c) in frame_speeds(m).into_iter().zip(counted) {
@@ -234,12 +237,15 @@ pub fn real_reference(motions: &[Vec<Pose>]) -> RealReference {
             }
         }
         joints.extend(joint_speeds(m));
-        skating += foot_skating(m);
+        per_motion.push(foot_skating(m));
     }
+    let skating = per_motion.iter().sum::<f64>() / motions.len().max(1) as f64;
     RealReference {
         motions: motions.len(),
         frames: motions.iter().map(Vec::len).sum(),
-        skating: skating / motions.len().max(1) as f64,
+        skating,
+        skating_share_above: per_motion.iter().filter(|&&s| s > skating).count() as f64
+            / motions.len().max(1) as f64,
         p99_fastest: quantile(fastest, 0.99),
         p99_fastest_outside_flight: quantile(outside, 0.99),
         p99_joint: quantile(joints, 0.99),

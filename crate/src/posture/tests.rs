@@ -1,6 +1,7 @@
 use super::check::{fuzz, round_trip_random};
 use super::script::{describe_pose, Constraint, PostureScript, ScriptError};
 use super::solver::{pose_of, rest_angles, solve};
+use super::track::PostureTrack;
 use crate::posecodes::{body_level, torso_lean, Lean, PelvisLevel};
 use crate::skeleton::{PARENTS, REFERENCE_BONE_LENGTHS};
 
@@ -150,4 +151,72 @@ fn every_named_posture_and_movement_key_is_read_back_in_full() {
     assert!(report.scripts >= 40 + 8, "{} scripts", report.scripts);
     assert_eq!(report.read_back, report.constraints, "{:#?}", report.misses);
     assert_eq!(report.limit_breaks + report.below_floor, 0);
+}
+
+#[test]
+fn a_lead_in_is_played_once_and_the_cycle_comes_back_to_it() {
+    use super::library::Library;
+    let library = Library::builtin();
+    let push_up = library
+        .actions
+        .iter()
+        .find(|a| a.name == "push-up")
+        .expect("the library has push-ups");
+    let track = push_up.track(Some(3), [0.0, 0.0]);
+    assert_eq!(track.lead_in, 1);
+    // Into the plank once, down and up three times, then back to standing.
+    let (plank, down) = (Some(0), Some(1));
+    assert_eq!(
+        track.played(),
+        vec![plank, down, plank, down, plank, down, plank, None]
+    );
+    // Timeline marks follow the same order and leave out the way back.
+    let marks: Vec<usize> = track.key_times(20.0).iter().map(|m| m.2).collect();
+    assert_eq!(marks, vec![0, 1, 0, 1, 0, 1, 0]);
+    let times: Vec<f64> = track.key_times(20.0).iter().map(|m| m.0).collect();
+    assert!(times.windows(2).all(|w| w[0] < w[1]), "{times:?}");
+
+    // Without a lead-in a repeated track comes back to the starting pose (squats).
+    let mut squats = track.clone();
+    squats.lead_in = 0;
+    squats.returns = false;
+    assert_eq!(
+        squats.played(),
+        vec![plank, down, None, plank, down, None, plank, down, None]
+    );
+    let once = PostureTrack {
+        repeat: 1,
+        ..squats
+    };
+    assert_eq!(once.played(), vec![plank, down]);
+    // A lead-in that leaves nothing to repeat is refused with a message.
+    let bad = PostureTrack {
+        lead_in: 2,
+        ..track
+    };
+    let err = bad.checked().unwrap_err();
+    assert!(err.contains("lead-in"), "{err}");
+}
+
+#[test]
+fn getting_down_to_the_floor_never_floats() {
+    use super::go::{go, KeyPose};
+    use super::library::Library;
+    use crate::posture::measure::in_flight;
+    let library = Library::builtin();
+    let stand = pose_of(&rest_angles());
+    for name in ["lie on the back", "lie on the front", "sit on the floor"] {
+        let posture = library.get(name).expect("a library posture");
+        let down = solve(&posture.script, None).pose;
+        let motion = go(&[
+            KeyPose::new(stand, 0.0, 0.2),
+            KeyPose::new(down, 1.0, 0.5),
+            KeyPose::new(stand, 1.0, 0.2),
+        ]);
+        let floating = in_flight(&motion).iter().filter(|f| **f).count();
+        assert_eq!(
+            floating, 0,
+            "{name}: {floating} frames with nothing on the floor"
+        );
+    }
 }

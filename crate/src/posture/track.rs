@@ -11,7 +11,7 @@ use super::go::{self, KeyPose, Transition};
 use super::script::PostureScript;
 use super::solver::{solve, Angles};
 use crate::geom::{self, Quat, Vec3};
-use crate::posecodes::facing;
+use crate::posecodes::{body_level, facing, torso_lean, Lean, PelvisLevel};
 use crate::skeleton::{self, BodyPart, Offsets, Pose};
 use crate::timing::FPS;
 use serde::{Deserialize, Serialize};
@@ -68,6 +68,10 @@ fn is_zero2(v: &[f64; 2]) -> bool {
     v[0] == 0.0 && v[1] == 0.0
 }
 
+fn is_zero_u32(v: &u32) -> bool {
+    *v == 0
+}
+
 fn one() -> u32 {
     1
 }
@@ -83,9 +87,15 @@ pub struct PostureTrack {
     /// The key poses in order (1 to [`MAX_KEYS`]).
     pub keys: Vec<TrackKey>,
     /// How many times the keys are played (1 to [`MAX_REPEAT`]); a repeated track comes back to
-    /// the pose it started from between and after the repetitions (squats × 3).
+    /// the pose it started from between and after the repetitions (squats × 3), or, with a
+    /// lead-in, to the lead-in's last key (see [`PostureTrack::played`]).
     #[serde(default = "one")]
     pub repeat: u32,
+    /// How many of the first keys lead into the cycle and are played once (push-ups: get into
+    /// the plank once, then down and up again); 0 when the whole track is the cycle. Fewer than
+    /// the keys.
+    #[serde(default, skip_serializing_if = "is_zero_u32")]
+    pub lead_in: u32,
     /// Whether the track ends back in the pose it started from (a squat goes down and comes
     /// up; "sits down" stays down).
     #[serde(default)]
@@ -104,6 +114,8 @@ struct TrackFields {
     #[serde(default = "one")]
     repeat: u32,
     #[serde(default)]
+    lead_in: u32,
+    #[serde(default)]
     returns: bool,
     #[serde(default)]
     within: Option<[f64; 2]>,
@@ -117,6 +129,7 @@ impl TryFrom<TrackFields> for PostureTrack {
             parts: f.parts,
             keys: f.keys,
             repeat: f.repeat,
+            lead_in: f.lead_in,
             returns: f.returns,
             within: f.within,
         }
@@ -137,6 +150,7 @@ impl PostureTrack {
                 jump_m: None,
             }],
             repeat: 1,
+            lead_in: 0,
             returns: false,
             within: None,
         }
@@ -163,6 +177,13 @@ impl PostureTrack {
                      before the second, not [{from}, {to}]"
                 ));
             }
+        }
+        if self.lead_in as usize >= self.keys.len() {
+            return Err(format!(
+                "a posture track's lead-in is fewer key poses than it has ({}), not {}",
+                self.keys.len(),
+                self.lead_in
+            ));
         }
         if !(1..=MAX_REPEAT).contains(&self.repeat) {
             return Err(format!(
@@ -214,23 +235,57 @@ impl PostureTrack {
         self.parts.len() == BodyPart::ALL.len()
     }
 
-    /// Seconds the track takes at its own pace: every transition and hold, times the
-    /// repetitions, plus the way back when it returns.
+    /// The order the go stage plays the keys in after the pose the track starts from:
+    /// `Some(i)` is key `i`, `None` the way back to the starting pose. The lead-in keys come
+    /// once, then the cycle `repeat` times; between repetitions the body comes back to where
+    /// the cycle starts (the lead-in's last key, or the starting pose), and a track that
+    /// returns or repeats ends in the starting pose.
+    pub fn played(&self) -> Vec<Option<usize>> {
+        let lead = (self.lead_in as usize).min(self.keys.len().saturating_sub(1));
+        let cycle: Vec<Option<usize>> = (lead..self.keys.len()).map(Some).collect();
+        let back = lead.checked_sub(1);
+        let mut out: Vec<Option<usize>> = (0..lead).map(Some).collect();
+        for n in 0..self.repeat.max(1) {
+            if n > 0 {
+                out.push(back);
+            }
+            out.extend(&cycle);
+        }
+        let repeated = self.repeat > 1;
+        if lead > 0 && repeated {
+            out.push(back);
+        }
+        if self.returns || (lead == 0 && repeated) {
+            out.push(None);
+        }
+        out
+    }
+
+    /// Seconds to move into a played key (`None`: back to the start, at the first key's pace)
+    /// and to hold it.
+    fn timing(&self, key: Option<usize>) -> (f64, f64) {
+        match key {
+            Some(i) => (self.keys[i].transition, self.keys[i].script.hold),
+            None => (self.keys[0].transition, 0.0),
+        }
+    }
+
+    /// Seconds the track takes at its own pace: every transition and hold as played.
     pub fn natural_seconds(&self) -> f64 {
-        let once: f64 = self.keys.iter().map(|k| k.transition + k.script.hold).sum();
-        let back = if self.returns || self.repeat > 1 {
-            self.keys[0].transition
-        } else {
-            0.0
-        };
-        once * self.repeat as f64 + back * self.repeat.max(1) as f64
+        self.played()
+            .into_iter()
+            .map(|k| {
+                let (moving, hold) = self.timing(k);
+                moving + hold
+            })
+            .sum()
     }
 
     /// The factors `(holds, transitions)` that make the track last `seconds`: spare time
     /// lengthens the holds (or, with none, the transitions), missing time shortens everything.
     pub fn time_scales(&self, seconds: f64) -> (f64, f64) {
         let natural = self.natural_seconds().max(1e-6);
-        let holds: f64 = self.keys.iter().map(|k| k.script.hold).sum::<f64>() * self.repeat as f64;
+        let holds: f64 = self.played().into_iter().map(|k| self.timing(k).1).sum();
         if seconds >= natural && holds > 0.0 {
             (1.0 + (seconds - natural) / holds, 1.0)
         } else {
@@ -239,28 +294,21 @@ impl PostureTrack {
     }
 
     /// When each key pose is reached when the track lasts `seconds`, by its own timing scaled
-    /// as [`PostureTrack::time_scales`] says, repetitions and the way back included: `(reached
-    /// s, held s, key index)`. The go stage may still lengthen a transition that would move a
-    /// joint too fast; these times do not follow that.
+    /// as [`PostureTrack::time_scales`] says, in the order [`PostureTrack::played`] gives:
+    /// `(reached s, held s, key index)`; the ways back to the start are not listed. The go stage
+    /// may still lengthen a transition that would move a joint too fast; these times do not
+    /// follow that.
     pub fn key_times(&self, seconds: f64) -> Vec<(f64, f64, usize)> {
         let (hold_scale, move_scale) = self.time_scales(seconds);
-        let back = if self.returns || self.repeat > 1 {
-            self.keys[0].transition * move_scale
-        } else {
-            0.0
-        };
         let mut out = Vec::new();
         let mut t = 0.0;
-        for cycle in 0..self.repeat.max(1) {
-            if cycle > 0 {
-                t += back;
+        for k in self.played() {
+            let (moving, hold) = self.timing(k);
+            t += moving * move_scale;
+            if let Some(i) = k {
+                out.push((t, hold * hold_scale, i));
             }
-            for (i, k) in self.keys.iter().enumerate() {
-                t += k.transition * move_scale;
-                let hold = k.script.hold * hold_scale;
-                out.push((t, hold, i));
-                t += hold;
-            }
+            t += hold * hold_scale;
         }
         out
     }
@@ -281,6 +329,94 @@ impl PostureTrack {
             })
             .collect()
     }
+}
+
+/// Poses the body passes through between standing and lying, so that it gets down to the floor
+/// and up again as people do (sitting down before lying back, kneeling on hands and knees
+/// before lying face down) instead of tipping over as one piece. Key shapes at the origin
+/// facing +Z, lowest joint on the floor; the named library provides them
+/// (`Library::bridges`).
+#[derive(Clone, Copy, Debug)]
+pub struct Bridges {
+    /// Passed through to and from lying on the back or side: sitting on the floor.
+    pub back: Pose,
+    /// Passed through to and from lying face down or in a plank: on hands and knees.
+    pub front: Pose,
+}
+
+impl Bridges {
+    /// The pose to pass through from key shape `a` to key shape `b`, if one is on the floor
+    /// lying and the other upright (standing or crouching).
+    fn between(&self, a: &Pose, b: &Pose) -> Option<Pose> {
+        let level = |p: &Pose| body_level(p, 0.0);
+        let upright = |p: &Pose| matches!(level(p), PelvisLevel::Standing | PelvisLevel::Crouching);
+        // A plank also reads as lying, but people get into it from a crouch, hands first.
+        let lying = |p: &Pose| {
+            level(p) == PelvisLevel::Lying && p[crate::skeleton::joint::PELVIS][1] < FLAT_PELVIS_M
+        };
+        let down = if upright(a) && lying(b) {
+            b
+        } else if lying(a) && upright(b) {
+            a
+        } else {
+            return None;
+        };
+        Some(match torso_lean(down) {
+            Lean::Forward => self.front,
+            _ => self.back,
+        })
+    }
+}
+
+/// Pelvis height (metres) under which a lying key is flat on the floor and is reached through
+/// a bridge pose; a push-up plank holds the pelvis higher.
+const FLAT_PELVIS_M: f64 = 0.2;
+/// Share of an eased transition each half takes when a bridge pose splits it: more than half,
+/// since the body now travels further.
+const BRIDGE_SHARE: f64 = 0.6;
+/// Seconds a bridge pose is held.
+const BRIDGE_HOLD: f64 = 0.1;
+
+/// Inserts a bridge pose into every eased transition between upright and lying keys (see
+/// [`Bridges`]); `labels` (the track key each go key shows, if any) gets `None` for each.
+fn bridged(
+    keys: Vec<KeyPose>,
+    labels: Vec<Option<usize>>,
+    bridges: Option<&Bridges>,
+) -> (Vec<KeyPose>, Vec<Option<usize>>) {
+    let Some(bridges) = bridges else {
+        return (keys, labels);
+    };
+    let mut out = Vec::with_capacity(keys.len());
+    let mut out_labels = Vec::with_capacity(labels.len());
+    for (i, (key, label)) in keys.into_iter().zip(labels).enumerate() {
+        let eased = key.motion == Transition::Ease;
+        let through = (i > 0 && eased)
+            .then(|| {
+                bridges.between(
+                    &out.last().map_or(key.pose, |k: &KeyPose| k.pose),
+                    &key.pose,
+                )
+            })
+            .flatten();
+        match through {
+            Some(pose) => {
+                out.push(KeyPose::new(
+                    pose,
+                    key.transition * BRIDGE_SHARE,
+                    BRIDGE_HOLD,
+                ));
+                out_labels.push(None);
+                out.push(KeyPose {
+                    transition: key.transition * BRIDGE_SHARE,
+                    ..key
+                });
+            }
+            None => out.push(key),
+        }
+        out_labels.push(label);
+    }
+    (out, out_labels)
 }
 
 /// A track placed on frames of the motion (20 fps).
@@ -354,17 +490,13 @@ fn solve_keys(track: &PostureTrack, chained: bool) -> (Vec<Pose>, Vec<String>) {
 }
 
 /// Frames (counted from the first key) at the middle of each key's hold, with the index of the
-/// track key it is, from the times the go stage reached the keys.
-fn key_frames(track: &PostureTrack, keys: &[KeyPose], reached: &[f64]) -> Vec<(usize, usize)> {
-    let cycle = track.keys.len() + 1;
+/// track key it is, from the go stage's keys, the track key each shows (`labels`) and the times
+/// the go stage reached them.
+fn key_frames(keys: &[KeyPose], labels: &[Option<usize>], reached: &[f64]) -> Vec<(usize, usize)> {
     keys.iter()
         .zip(reached)
-        .enumerate()
-        .filter_map(|(j, (k, t))| {
-            let c = j % cycle;
-            (j > 0 && c > 0 && c <= track.keys.len())
-                .then(|| (((t + k.hold / 2.0) * FPS).round() as usize, c - 1))
-        })
+        .zip(labels)
+        .filter_map(|((k, t), key)| key.map(|i| (((t + k.hold / 2.0) * FPS).round() as usize, i)))
         .collect()
 }
 
@@ -407,40 +539,52 @@ fn review_keys(motion: &[Pose], track: &PostureTrack, checks: &[(usize, usize)])
 }
 
 /// The go stage's keys for a track that starts in `start` (a pose at the origin facing +Z),
-/// with transitions and holds scaled so that the track fills `seconds`: spare time lengthens
-/// the holds (or, with none, the transitions), missing time shortens everything.
-fn go_keys(track: &PostureTrack, start: Pose, solved: &[Pose], seconds: f64) -> Vec<KeyPose> {
+/// played as [`PostureTrack::played`] says, with transitions and holds scaled so that the track
+/// fills `seconds`: spare time lengthens the holds (or, with none, the transitions), missing
+/// time shortens everything. With each key, the track key it shows (`None` for the start and
+/// the ways back to it).
+fn go_keys(
+    track: &PostureTrack,
+    start: Pose,
+    solved: &[Pose],
+    seconds: f64,
+) -> (Vec<KeyPose>, Vec<Option<usize>>) {
     let (hold_scale, move_scale) = track.time_scales(seconds);
-    let first = KeyPose::new(start, 0.0, 0.0);
-    let mut cycle = vec![first];
-    for (k, pose) in track.keys.iter().zip(solved) {
-        cycle.push(KeyPose {
-            pose: *pose,
-            transition: k.transition * move_scale,
-            hold: k.script.hold * hold_scale,
-            turn_deg: k.turn_deg,
-            travel: k.travel,
-            motion: match k.jump_m {
-                Some(apex_m) => Transition::Flight { apex_m },
-                None => Transition::Ease,
+    let mut keys = vec![KeyPose::new(start, 0.0, 0.0)];
+    let labels = std::iter::once(None).chain(track.played()).collect();
+    for played in track.played() {
+        let (moving, hold) = track.timing(played);
+        let key = KeyPose::new(
+            played.map_or(start, |i| solved[i]),
+            moving * move_scale,
+            hold * hold_scale,
+        );
+        keys.push(match played.map(|i| &track.keys[i]) {
+            Some(k) => KeyPose {
+                turn_deg: k.turn_deg,
+                travel: k.travel,
+                motion: match k.jump_m {
+                    Some(apex_m) => Transition::Flight { apex_m },
+                    None => Transition::Ease,
+                },
+                ..key
             },
+            None => key,
         });
     }
-    if track.returns || track.repeat > 1 {
-        // The way back into the start uses the first key's transition time.
-        cycle[0].transition = track.keys[0].transition * move_scale;
-        go::repeat(&cycle, track.repeat as usize)
-    } else {
-        cycle
-    }
+    (keys, labels)
 }
 
 /// Lays posture tracks over a motion (world joints, 20 fps) and returns the new motion with
 /// notes (key poses that could not be met in full, tracks that needed more time than their
 /// frames). Spans are taken in order of their first frame; a whole-body span may change the
 /// motion's length when its key poses need more time than the span has, and later spans move
-/// with it.
-pub fn lay_tracks(base: &[Pose], spans: &[TrackSpan<'_>]) -> (Vec<Pose>, Vec<String>) {
+/// with it. With `bridges`, posture segments get down to the floor and up again through them.
+pub fn lay_tracks(
+    base: &[Pose],
+    spans: &[TrackSpan<'_>],
+    bridges: Option<&Bridges>,
+) -> (Vec<Pose>, Vec<String>) {
     let mut out = base.to_vec();
     let mut notes = Vec::new();
     let mut spans = spans.to_vec();
@@ -458,7 +602,11 @@ pub fn lay_tracks(base: &[Pose], spans: &[TrackSpan<'_>]) -> (Vec<Pose>, Vec<Str
             let mut laid = out.clone();
             let mut lay_notes = key_notes;
             let checks = if span.track.whole_body() {
-                lay_whole_body(&mut laid, start, end, span.track, &solved, &mut lay_notes)
+                let solved = Solved {
+                    poses: &solved,
+                    bridges,
+                };
+                lay_whole_body(&mut laid, start, end, span.track, solved, &mut lay_notes)
             } else {
                 lay_on_parts(&mut laid, start, end, span.track, &solved)
             };
@@ -504,12 +652,18 @@ pub fn lay_tracks(base: &[Pose], spans: &[TrackSpan<'_>]) -> (Vec<Pose>, Vec<Str
     (out, notes)
 }
 
+/// A track's key poses as solved, with the bridges to pass through on the way to the floor.
+struct Solved<'a> {
+    poses: &'a [Pose],
+    bridges: Option<&'a Bridges>,
+}
+
 fn lay_whole_body(
     out: &mut Vec<Pose>,
     start: usize,
     end: usize,
     track: &PostureTrack,
-    solved: &[Pose],
+    solved: Solved<'_>,
     notes: &mut Vec<String>,
 ) -> Vec<(usize, usize)> {
     // Continue from the last frame before the span (the first frame when the span opens the
@@ -526,15 +680,16 @@ fn lay_whole_body(
         0.0
     };
     let seconds = ((end - from) as f64 / FPS - exit).max(0.5 * (end - from) as f64 / FPS);
-    let mut keys = go_keys(track, place.to_local(&out[from]), solved, seconds);
-    let track_keys = keys.len();
+    let (mut keys, mut labels) = go_keys(track, place.to_local(&out[from]), solved.poses, seconds);
     if let Some(next) = next {
         // End in the shape the next segment starts with, so it follows without a jump.
         let shape = Placement::of(&next).to_local(&next);
         keys.push(KeyPose::new(shape, DEFAULT_TRANSITION_SECONDS, 0.0));
+        labels.push(None);
     }
+    let (keys, labels) = bridged(keys, labels, solved.bridges);
     let (local, reached) = go::go_timed(&keys);
-    let checks: Vec<(usize, usize)> = key_frames(track, &keys[..track_keys], &reached)
+    let checks: Vec<(usize, usize)> = key_frames(&keys, &labels, &reached)
         .into_iter()
         .map(|(f, k)| (from + f, k))
         .collect();
@@ -578,14 +733,14 @@ fn lay_on_parts(
         return Vec::new();
     }
     let place = Placement::of(&out[start]);
-    let keys = go_keys(
+    let (keys, labels) = go_keys(
         track,
         place.to_local(&out[start]),
         solved,
         frames as f64 / FPS,
     );
     let (local, reached) = go::go_timed(&keys);
-    let checks: Vec<(usize, usize)> = key_frames(track, &keys, &reached)
+    let checks: Vec<(usize, usize)> = key_frames(&keys, &labels, &reached)
         .into_iter()
         .filter(|(f, _)| *f < frames)
         .map(|(f, k)| (start + f, k))

@@ -316,6 +316,7 @@ impl DecomposeReply {
                     parts: BodyPart::ALL.to_vec(),
                     keys,
                     repeat: 1,
+                    lead_in: 0,
                     returns: false,
                     within: None,
                 }

@@ -336,7 +336,7 @@ fn from_rest(track: &PostureTrack) -> Result<(Vec<Pose>, Vec<String>, Range<usiz
         frames: lead..lead + span,
         track,
     }];
-    let (laid, notes) = lay_tracks(&base, &spans);
+    let (laid, notes) = lay_tracks(&base, &spans, Library::builtin_bridges());
     // Frames the key poses added (or, when they needed less time, took away).
     let grown = laid.len() as isize - base.len() as isize;
     // As `Session::motion` does: features of the joints (the last pose becomes the last row's
@@ -437,7 +437,11 @@ fn posture_frames(
         .collect();
     spans.sort_by_key(|(_, s)| s.frames.start);
     let only: Vec<TrackSpan> = spans.iter().map(|(_, s)| s.clone()).collect();
-    let length = |k: usize| lay_tracks(&base, &only[..k]).0.len();
+    let length = |k: usize| {
+        lay_tracks(&base, &only[..k], Library::builtin_bridges())
+            .0
+            .len()
+    };
     let mut out = Vec::new();
     let mut before = base.len();
     for (k, (segment, span)) in spans.iter().enumerate() {
@@ -583,9 +587,12 @@ fn print_measured(rows: &[Measured], real: &RealReference, bar: f64) {
         .count();
     println!(
         "  overall, {} motions: foot skating mean {mean:.3}, pooled over frames {pooled:.3} \
-         (real {:.3}; {skating_over} motions above it, worst {:.3}: {})",
+         (real {:.3}; {skating_over} motions above it, {:.0} %, against {:.0} % of the real \
+         motions; worst {:.3}: {})",
         rows.len(),
         real.skating,
+        100.0 * skating_over as f64 / rows.len().max(1) as f64,
+        100.0 * real.skating_share_above,
         worst_skate.measure.skating,
         worst_skate.name
     );
