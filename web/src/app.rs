@@ -104,6 +104,20 @@ impl AppState {
         });
     }
 
+    /// Decodes `take`'s tokens again with `plan` (a posture laid on it, a path drawn for a
+    /// segment): a new take once the worker answers, `line` saying what changed and `edit`
+    /// what its history records.
+    pub fn decode_with_plan(&self, take: &Take, plan: Plan, line: String, edit: Option<Edit>) {
+        self.request(
+            Command::Decode {
+                tokens: take.motion.tokens.clone(),
+                plan: Some(plan.clone()),
+            },
+            None,
+            Pending::Plan { plan, line, edit },
+        );
+    }
+
     /// Sends an engine command (with the LLM to use, if any) whose motion becomes `pending`;
     /// refused while another one runs.
     pub fn request(&self, command: Command, llm: Option<LlmSettings>, pending: Pending) {

@@ -220,3 +220,93 @@ fn getting_down_to_the_floor_never_floats() {
         );
     }
 }
+
+/// A named posture of the built-in library, solved.
+fn library_pose(name: &str) -> crate::skeleton::Pose {
+    let posture = super::library::Library::builtin()
+        .get(name)
+        .expect("a library posture");
+    solve(&posture.script, None).pose
+}
+
+#[test]
+fn adjacent_posture_segments_join_without_the_generated_frame_between_them() {
+    use super::track::{lay_tracks, TrackSpan};
+    use crate::skeleton::{joint, BodyPart};
+    let stand = pose_of(&rest_angles());
+    let arms_up = library_pose("stretching arms up");
+    // "Generated" frames: standing, then arms up everywhere a posture does not replace them.
+    let base: Vec<_> = (0..90)
+        .map(|f| if f < 10 { stand } else { arms_up })
+        .collect();
+    let library = super::library::Library::builtin();
+    let track = |name: &str| {
+        PostureTrack::holding(
+            BodyPart::ALL.to_vec(),
+            library.get(name).unwrap().script.clone(),
+        )
+    };
+    let (t_pose, squat) = (track("T-pose"), track("squat"));
+    let spans = [
+        TrackSpan {
+            frames: 10..40,
+            track: &t_pose,
+        },
+        TrackSpan {
+            frames: 40..70,
+            track: &squat,
+        },
+    ];
+    let (laid, _) = lay_tracks(&base, &spans, None);
+    // From the T-pose to the end of the squat's hold the hands never go above the head, as
+    // they would passing through the generated frame at the join.
+    let above_head = |p: &crate::skeleton::Pose| {
+        p[joint::L_WRIST][1] > p[joint::HEAD][1] && p[joint::R_WRIST][1] > p[joint::HEAD][1]
+    };
+    let t_at = laid
+        .iter()
+        .position(|p| (p[joint::L_WRIST][1] - p[joint::L_SHOULDER][1]).abs() < 0.05)
+        .expect("the T-pose is reached");
+    let squat_at = laid
+        .iter()
+        .position(|p| p[joint::PELVIS][1] < stand[joint::PELVIS][1] - 0.2)
+        .expect("the squat is reached");
+    assert!(t_at < squat_at);
+    let raised = (t_at..squat_at).filter(|&f| above_head(&laid[f])).count();
+    assert_eq!(
+        raised, 0,
+        "{raised} frames with the hands up between the poses"
+    );
+}
+
+#[test]
+fn a_kneel_held_on_the_legs_kneels_on_the_floor() {
+    use super::track::{lay_tracks, TrackSpan};
+    use crate::posecodes::{Support, KNEE_CONTACT_M};
+    use crate::skeleton::BodyPart;
+    let stand = pose_of(&rest_angles());
+    let base = vec![stand; 60];
+    let kneel = super::library::Library::builtin()
+        .get("kneel on both knees")
+        .unwrap()
+        .script
+        .clone();
+    let track = PostureTrack::holding(vec![BodyPart::LeftLeg, BodyPart::RightLeg], kneel);
+    let spans = [TrackSpan {
+        frames: 0..60,
+        track: &track,
+    }];
+    let (laid, _) = lay_tracks(&base, &spans, None);
+    let skating = crate::posture::measure::foot_skating(&laid);
+    assert!(
+        skating <= 0.051,
+        "the feet slide into the kneel: skating {skating}"
+    );
+    let held = &laid[40];
+    let low = held.iter().map(|j| j[1]).fold(f64::INFINITY, f64::min);
+    assert!(low.abs() < 0.02, "lowest joint {low} m above the floor");
+    for knee in [Support::LeftKnee, Support::RightKnee] {
+        let (height, _) = knee.clearance(held, 0.0);
+        assert!(height < KNEE_CONTACT_M, "{} {height} m up", knee.as_str());
+    }
+}

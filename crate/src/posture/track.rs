@@ -590,7 +590,16 @@ pub fn lay_tracks(
     let mut spans = spans.to_vec();
     spans.sort_by_key(|s| s.frames.start);
     let mut shift: isize = 0;
-    for span in spans {
+    // A posture segment followed at once by another ends in its own last key: the next starts
+    // from there instead of both passing through the generated frame between them.
+    let handed_on: Vec<bool> = (0..spans.len())
+        .map(|k| {
+            spans
+                .get(k + 1)
+                .is_some_and(|n| n.track.whole_body() && n.frames.start <= spans[k].frames.end)
+        })
+        .collect();
+    for (span, handed_on) in spans.into_iter().zip(handed_on) {
         if out.is_empty() {
             break;
         }
@@ -605,6 +614,7 @@ pub fn lay_tracks(
                 let solved = Solved {
                     poses: &solved,
                     bridges,
+                    handed_on,
                 };
                 lay_whole_body(&mut laid, start, end, span.track, solved, &mut lay_notes)
             } else {
@@ -656,6 +666,8 @@ pub fn lay_tracks(
 struct Solved<'a> {
     poses: &'a [Pose],
     bridges: Option<&'a Bridges>,
+    /// The next span is a posture segment that starts where this one ends.
+    handed_on: bool,
 }
 
 fn lay_whole_body(
@@ -672,7 +684,7 @@ fn lay_whole_body(
     let place = Placement::of(&out[from]);
     // The features' last row leads to one more pose than they describe: a span that reaches it
     // ends the motion, with nothing to join.
-    let next = (end + 1 < out.len()).then(|| out[end]);
+    let next = (end + 1 < out.len() && !solved.handed_on).then(|| out[end]);
     // The way out into the next segment's first pose is part of the span.
     let exit = if next.is_some() {
         DEFAULT_TRANSITION_SECONDS
@@ -753,6 +765,10 @@ fn lay_on_parts(
         .iter()
         .flat_map(|p| p.limb_joints().iter().copied())
         .collect();
+    let holds_legs = track
+        .parts
+        .iter()
+        .any(|p| matches!(p, BodyPart::LeftLeg | BodyPart::RightLeg));
     let offsets = Offsets::reference();
     for f in 0..frames {
         let t = f as f64;
@@ -772,13 +788,25 @@ fn lay_on_parts(
         for &j in &bones {
             rots[j] = rots[j].slerp(goal[j], weight);
         }
-        let mut pose = skeleton::forward_kinematics(&[rots], &offsets, &[out[frame][0]])[0];
-        // A leg laid over a motion must not push the body through the floor.
-        let lowest = pose.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
-        if lowest < 0.0 {
-            for p in pose.iter_mut() {
-                p[1] -= lowest;
-            }
+        // Held legs move the pelvis as the go stage moves it over their planted feet (back and
+        // down into a kneel); held arms leave it where the generated body has it.
+        let root = if holds_legs {
+            geom::lerp(out[frame][0], target[0], weight)
+        } else {
+            out[frame][0]
+        };
+        let mut pose = skeleton::forward_kinematics(&[rots], &offsets, &[root])[0];
+        let lowest = |p: &Pose| p.iter().map(|j| j[1]).fold(f64::INFINITY, f64::min);
+        // Held legs carry the body: it stands on them as it stood on the generated legs
+        // (a kneel held over a standing motion kneels on the floor, not in mid-air). Held arms
+        // leave the height alone, unless they would go through the floor.
+        let drop = if holds_legs {
+            lowest(&pose) - lowest(&out[frame])
+        } else {
+            lowest(&pose).min(0.0)
+        };
+        for p in pose.iter_mut() {
+            p[1] -= drop;
         }
         out[frame] = pose;
     }

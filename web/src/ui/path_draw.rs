@@ -8,10 +8,9 @@
 //! Cancel stops without changing anything; a stroke too short to walk says so and keeps the
 //! take.
 
-use crate::app::{AppState, Pending};
+use crate::app::AppState;
 use crate::take::with_drawn_path;
 use crate::ui::segments::next_seed;
-use coma::session::Command;
 use leptos::prelude::*;
 
 /// The drawing in progress, shared by the viewer's canvas (which picks the points) and the
@@ -93,18 +92,7 @@ impl Pen {
                 // The stroke stays on screen until the laid path replaces it (see PathDraw).
                 self.on.set(false);
                 state.say(format!("laying the drawn path: {line}…"));
-                state.request(
-                    Command::Decode {
-                        tokens: take.motion.tokens.clone(),
-                        plan: Some(edit.plan.clone()),
-                    },
-                    None,
-                    Pending::Plan {
-                        plan: edit.plan,
-                        line,
-                        edit: Some(record),
-                    },
-                );
+                state.decode_with_plan(&take, edit.plan, line, Some(record));
             }
         }
     }

@@ -4,10 +4,9 @@
 //! whose segment holds the posture, so nothing is regenerated, the result is a new take (undo
 //! goes back) and its share link rebuilds it.
 
-use crate::app::{AppState, Pending};
+use crate::app::AppState;
 use crate::take::with_posture;
 use coma::posture::library::Library;
-use coma::session::Command;
 use coma::skeleton::BodyPart;
 use coma::timing::FPS;
 use leptos::prelude::*;
@@ -108,18 +107,7 @@ pub fn PosturePicker(
                     ));
                 }
                 state.say(format!("laying the posture: {line}…"));
-                state.request(
-                    Command::Decode {
-                        tokens: take.motion.tokens.clone(),
-                        plan: Some(edit.plan.clone()),
-                    },
-                    None,
-                    Pending::Plan {
-                        plan: edit.plan,
-                        line,
-                        edit: None,
-                    },
-                );
+                state.decode_with_plan(&take, edit.plan, line, None);
             }
         }
     };

@@ -248,6 +248,12 @@ pub fn is_finite_verb(word: &str) -> bool {
         "keeps",
         "continue",
         "continues",
+        "transition",
+        "transitions",
+        "switch",
+        "switches",
+        "change",
+        "changes",
     ];
     if OTHER.contains(&word) {
         return true;
