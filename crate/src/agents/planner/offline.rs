@@ -73,6 +73,7 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
         let model_parts = model.as_ref().map(|m| (m.base, m.gestures.as_slice()));
         if let Some(planned) = postures::plan_clause(&words, model_parts, &model_segment) {
             notes.extend(planned.notes);
+            postures::land_in(&words, segments.last_mut(), &planned.segment);
             previous = None;
             segments.push(planned.segment);
             continue;

@@ -150,6 +150,39 @@ pub enum Stay {
     Hold,
 }
 
+/// A jump lands in the posture that a "lands in …" clause names ("jumps up and lands in a
+/// superhero landing"): the previous segment's last flight key becomes that posture and the
+/// keys after it (the way back up to standing) go, so the posture comes out of the jump
+/// instead of from standing after it. The landing clause keeps its own segment, which then
+/// holds the pose. Returns whether the jump was changed.
+pub fn land_in(words: &[&str], previous: Option<&mut Segment>, landing: &Segment) -> bool {
+    let lands = words.iter().any(|w| matches!(*w, "land" | "lands"));
+    let (Some(previous), Some(pose)) = (previous, landing.postures.as_ref()) else {
+        return false;
+    };
+    let Some(jump) = previous.postures.as_mut() else {
+        return false;
+    };
+    let single = pose.whole_body() && pose.keys.len() == 1 && pose.repeat == 1;
+    let Some(flight) = jump.keys.iter().rposition(|k| k.jump_m.is_some()) else {
+        return false;
+    };
+    if !(lands && single && jump.whole_body() && jump.repeat == 1) {
+        return false;
+    }
+    let mut landed = jump.clone();
+    landed.keys[flight].script = pose.keys[0].script.clone();
+    landed.keys.truncate(flight + 1);
+    landed.returns = false;
+    let Ok(landed) = landed.checked() else {
+        return false;
+    };
+    previous.seconds =
+        clamp_seconds(landed.natural_seconds() + DEFAULT_TRANSITION_SECONDS).unwrap_or(2.0);
+    *jump = landed;
+    true
+}
+
 /// Whether a clause with no movement only asks to stay as one is, and how.
 pub fn stay(words: &[&str]) -> Option<Stay> {
     const PASSING: &[&str] = &[

@@ -300,3 +300,37 @@ fn every_word_the_planner_writes_is_in_the_training_vocabulary() {
     }
     assert!(unknown.is_empty(), "words the model never saw: {unknown:?}");
 }
+
+#[test]
+fn a_jump_lands_in_the_posture_the_next_clause_names() {
+    let jumped = plan("He jumps up and lands in a superhero landing.", None);
+    assert_eq!(jumped.segments.len(), 2, "{:#?}", jumped.segments);
+    let jump = jumped.segments[0]
+        .postures
+        .as_ref()
+        .expect("the jump's key poses");
+    let last = jump.keys.last().unwrap();
+    assert!(
+        last.jump_m.is_some(),
+        "the last key is reached by the flight"
+    );
+    assert_eq!(last.script.name.as_deref(), Some("superhero landing"));
+    let held = jumped.segments[1]
+        .postures
+        .as_ref()
+        .expect("the landing held");
+    assert_eq!(held.keys[0].script, last.script);
+    // Landing with nothing named, or landing after something that is not a jump, is left as
+    // it was: the jump ends standing.
+    let plain = plan("A cheerleader jumps, then lands and claps.", None);
+    let jump = plain.segments[0].postures.as_ref().unwrap();
+    assert!(jump.keys.last().unwrap().jump_m.is_none());
+    let squat = plan("He squats, then lands in a superhero landing.", None);
+    assert!(squat.segments[0]
+        .postures
+        .as_ref()
+        .unwrap()
+        .keys
+        .iter()
+        .all(|k| k.jump_m.is_none()));
+}
