@@ -20,7 +20,7 @@
 //!   limb on the ground in both keys at the same place stays planted; one that must move (the
 //!   body travels or turns under it) steps: it stays put, lifts, moves and sets down inside its
 //!   own window of the transition, limbs one after another. A limb that leaves the ground
-//!   carries weight through the first half of the transition, then lifts into the body's
+//!   carries weight through the first part of the transition, then lifts into the body's
 //!   shape. Two-bone IK (hip–knee–ankle, shoulder–elbow–wrist) holds the targets; the pelvis
 //!   sinks when a planted foot would be out of reach, and the body rises when any joint would
 //!   go under the floor. With nothing on the ground in both keys, the body rests on its lowest
@@ -48,7 +48,7 @@ pub const MAX_JOINT_SPEED: f64 = 3.5;
 pub const GRAVITY: f64 = 9.81;
 
 /// How close to the floor (metres) a joint must be in a key pose to be on the ground there: the
-/// describer's own thresholds ([`crate::posecodes::body::Support`]), so a hand the script puts
+/// describer's own thresholds ([`crate::posecodes::Support`]), so a hand the script puts
 /// on the ground (a wrist 8 cm up, the joint sits above the palm) carries weight here too.
 /// Feet (ankle, toe) and the joints not listed take [`FOOT_CONTACT_M`].
 pub fn contact_height(j: usize) -> f64 {

@@ -309,4 +309,35 @@ fn a_kneel_held_on_the_legs_kneels_on_the_floor() {
         let (height, _) = knee.clearance(held, 0.0);
         assert!(height < KNEE_CONTACT_M, "{} {height} m up", knee.as_str());
     }
+
+    // Let go before the motion ends, the kneel stands up again over planted feet and hands
+    // the legs back to the generated motion.
+    let base = vec![stand; 90];
+    let spans = [TrackSpan {
+        frames: 0..60,
+        track: &track,
+    }];
+    let (laid, _) = lay_tracks(&base, &spans, None);
+    assert_eq!(laid.len(), 90);
+    let skating = crate::posture::measure::foot_skating(&laid);
+    assert!(
+        skating <= 0.051,
+        "the feet slide on the way out: skating {skating}"
+    );
+    let kneeling = laid[..60]
+        .iter()
+        .any(|p| Support::LeftKnee.clearance(p, 0.0).0 < KNEE_CONTACT_M);
+    assert!(kneeling, "never kneels");
+    for (f, pose) in laid[60..].iter().enumerate() {
+        let moved = pose
+            .iter()
+            .zip(&stand)
+            .map(|(a, b)| crate::geom::dist(*a, *b))
+            .fold(0.0, f64::max);
+        assert!(
+            moved < 0.02,
+            "frame {}: {moved} m from the generated pose",
+            60 + f
+        );
+    }
 }

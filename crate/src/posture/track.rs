@@ -180,7 +180,7 @@ impl PostureTrack {
         }
         if self.lead_in as usize >= self.keys.len() {
             return Err(format!(
-                "a posture track's lead-in is fewer key poses than it has ({}), not {}",
+                "a posture track's lead-in must be fewer key poses than the track has ({}), not {}",
                 self.keys.len(),
                 self.lead_in
             ));
@@ -340,7 +340,7 @@ impl PostureTrack {
 pub struct Bridges {
     /// Passed through to and from lying on the back or side: sitting on the floor.
     pub back: Pose,
-    /// Passed through to and from lying face down or in a plank: on hands and knees.
+    /// Passed through to and from lying face down: on hands and knees.
     pub front: Pose,
 }
 
@@ -745,19 +745,34 @@ fn lay_on_parts(
         return Vec::new();
     }
     let place = Placement::of(&out[start]);
-    let (keys, labels) = go_keys(
+    let held_to_end = end >= out.len();
+    let holds_legs = track
+        .parts
+        .iter()
+        .any(|p| matches!(p, BodyPart::LeftLeg | BodyPart::RightLeg));
+    // Held legs let go by moving back into the generated legs' shape over planted feet (a
+    // kneel stands up), not by blending over the floor: the way back is a key of the track.
+    let exit = if holds_legs && !held_to_end {
+        DEFAULT_TRANSITION_SECONDS.min(frames as f64 / FPS / 3.0)
+    } else {
+        0.0
+    };
+    let (mut keys, mut labels) = go_keys(
         track,
         place.to_local(&out[start]),
         solved,
-        frames as f64 / FPS,
+        frames as f64 / FPS - exit,
     );
+    if exit > 0.0 {
+        keys.push(KeyPose::new(place.to_local(&out[end - 1]), exit, 0.0));
+        labels.push(None);
+    }
     let (local, reached) = go::go_timed(&keys);
     let checks: Vec<(usize, usize)> = key_frames(&keys, &labels, &reached)
         .into_iter()
         .filter(|(f, _)| *f < frames)
         .map(|(f, k)| (start + f, k))
         .collect();
-    let held_to_end = end >= out.len();
     let ease_in = (track.keys[0].transition * FPS).max(1.0);
     let ease_out = (RELEASE_SECONDS * FPS).min(frames as f64 / 4.0).max(1.0);
     let bones: Vec<usize> = track
@@ -765,14 +780,15 @@ fn lay_on_parts(
         .iter()
         .flat_map(|p| p.limb_joints().iter().copied())
         .collect();
-    let holds_legs = track
-        .parts
-        .iter()
-        .any(|p| matches!(p, BodyPart::LeftLeg | BodyPart::RightLeg));
     let offsets = Offsets::reference();
     for f in 0..frames {
         let t = f as f64;
-        let weight = if held_to_end {
+        // Held legs need no blending in or out: the go stage starts from the generated pose
+        // and ends in it, over planted feet; blending their rotations as well would drag the
+        // feet over the floor.
+        let weight = if holds_legs {
+            1.0
+        } else if held_to_end {
             geom::ease(t / ease_in)
         } else {
             geom::ease(t / ease_in).min(geom::ease((frames as f64 - 1.0 - t) / ease_out))
@@ -781,11 +797,19 @@ fn lay_on_parts(
             continue;
         }
         let frame = start + f;
-        // Placed where the generated body is now, so held arms turn with a body that turns.
-        let target = Placement::of(&out[frame]).to_world(&local[f.min(local.len() - 1)]);
+        // Held arms are placed where the generated body is now, so they turn with a body that
+        // turns; held legs stand where the track started, since they carry the body and their
+        // feet stay planted where the go stage put them.
+        let placement = if holds_legs {
+            place
+        } else {
+            Placement::of(&out[frame])
+        };
+        let target = placement.to_world(&local[f.min(local.len() - 1)]);
         let mut rots = skeleton::inverse_kinematics(&[out[frame]], false)[0];
         let goal = skeleton::inverse_kinematics(&[target], false)[0];
-        for &j in &bones {
+        let turned = holds_legs.then_some(0);
+        for &j in bones.iter().chain(&turned) {
             rots[j] = rots[j].slerp(goal[j], weight);
         }
         // Held legs move the pelvis as the go stage moves it over their planted feet (back and
