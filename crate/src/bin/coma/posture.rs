@@ -320,6 +320,9 @@ struct Measured {
     name: String,
     whole_body: bool,
     measure: Measure,
+    /// For a posture held on some parts: the same frames of the generated motion decoded
+    /// without it, to tell what the held parts add from what the motion under them does.
+    without: Option<Measure>,
 }
 
 /// A track laid over a standing rest pose as the engine lays a posture segment: half a second
@@ -401,21 +404,32 @@ fn library_motions(bar: f64, out: Option<&Path>) -> Result<Vec<Measured>> {
             measure: measure::measure(made, bar),
             whole_body: track.whole_body(),
             name,
+            without: None,
         });
     }
     Ok(rows)
 }
 
-/// Where the posture tracks of a run's plan lie in its motion: per track (in the order they
-/// are laid), the segment's index, whether it drives the whole body, and the frames it made.
-/// The motion is laid again here, a track at a time, to follow how whole-body tracks lengthen
-/// or shorten it (as `pipeline::lay_postures` does in one go); the last figure is the length of
-/// the whole laid motion (joints, with the features' final frame).
+/// Where one posture track of a run's plan lies: the segment's index, whether it drives the
+/// whole body, the frames it made in the laid motion, and the frames it covered in the
+/// generated motion before any track was laid.
+struct LaidSpan {
+    segment: usize,
+    whole_body: bool,
+    frames: Range<usize>,
+    generated: Range<usize>,
+}
+
+/// Where the posture tracks of a run's plan lie in its motion, in the order they are laid,
+/// with the generated motion under them (joints with the features' final frame, no track
+/// laid). The motion is laid again here, a track at a time, to follow how whole-body tracks
+/// lengthen or shorten it (as `pipeline::lay_postures` does in one go); the last figure is
+/// the length of the whole laid motion (joints, with the features' final frame).
 fn posture_frames(
     model: &coma::model::MotionModel,
     plan: &coma::plan::Plan,
     tokens: &coma::model::tokens::MotionTokens,
-) -> (Vec<(usize, bool, Range<usize>)>, usize) {
+) -> (Vec<LaidSpan>, Vec<Pose>, usize) {
     let features = block_on(pipeline::motion_features(model, plan, tokens)).0;
     let base = features_to_joints_with_final(&with_reference_bones(&features));
     let mut spans: Vec<(usize, TrackSpan)> = plan
@@ -456,10 +470,16 @@ fn posture_frames(
         } else {
             start..end
         };
-        out.push((*segment, span.track.whole_body(), frames));
+        let generated = span.frames.start.min(base.len())..span.frames.end.min(base.len());
+        out.push(LaidSpan {
+            segment: *segment,
+            whole_body: span.track.whole_body(),
+            frames,
+            generated,
+        });
         before = after;
     }
-    (out, before)
+    (out, base, before)
 }
 
 /// Runs every prompt of a set as `coma run` does (no LLM) and measures its posture tracks.
@@ -486,7 +506,8 @@ fn prompt_motions(args: &MotionsArgs, set: &Path, bar: f64) -> Result<(Vec<Measu
             continue;
         }
         let joints = features_to_joints(&run.motion.features);
-        let (spans, laid) = posture_frames(session.model(), &run.plan, &run.motion.tokens);
+        let (spans, generated, laid) =
+            posture_frames(session.model(), &run.plan, &run.motion.tokens);
         if laid != joints.len() + 1 {
             eprintln!(
                 "note: '{}': the motion has {} frames, laying its postures again gave {}",
@@ -495,9 +516,9 @@ fn prompt_motions(args: &MotionsArgs, set: &Path, bar: f64) -> Result<(Vec<Measu
                 laid.saturating_sub(1)
             );
         }
-        for (segment, whole, frames) in spans {
-            let frames = frames.start.min(joints.len())..frames.end.min(joints.len());
-            let s = &run.plan.segments[segment];
+        for span in spans {
+            let frames = span.frames.start.min(joints.len())..span.frames.end.min(joints.len());
+            let s = &run.plan.segments[span.segment];
             let keys: Vec<&str> = s
                 .postures
                 .iter()
@@ -508,14 +529,16 @@ fn prompt_motions(args: &MotionsArgs, set: &Path, bar: f64) -> Result<(Vec<Measu
                 name: format!(
                     "\"{}\" seg {} {}[{}] frames {}..{}",
                     p.prompt,
-                    segment + 1,
-                    if whole { "" } else { "on parts " },
+                    span.segment + 1,
+                    if span.whole_body { "" } else { "on parts " },
                     keys.join(", "),
                     frames.start,
                     frames.end
                 ),
-                whole_body: whole,
+                whole_body: span.whole_body,
                 measure: measure::measure(&joints[frames], bar),
+                without: (!span.whole_body)
+                    .then(|| measure::measure(&generated[span.generated], bar)),
             });
         }
     }
@@ -547,6 +570,19 @@ fn print_measured(rows: &[Measured], real: &RealReference, bar: f64) {
             if m.passes(real.skating) { "yes" } else { "NO" },
             r.name
         );
+        if let Some(w) = &r.without {
+            println!(
+                "  {:>6} {:>8.3} {:>10.1} {:>6} {:>12}  {:<30} {:>5}    the generated motion \
+                 under it, without the posture",
+                w.frames,
+                w.skating,
+                w.lowest_m * 100.0,
+                w.flight_frames,
+                w.fastest.map_or("-".into(), |f| format!("{:.2}", f.speed)),
+                "",
+                if w.passes(real.skating) { "yes" } else { "NO" },
+            );
+        }
     }
     if rows.is_empty() {
         return;
@@ -610,6 +646,20 @@ fn print_measured(rows: &[Measured], real: &RealReference, bar: f64) {
             f.joint_name(),
             f.frame as f64 / FPS,
             r.name
+        );
+    }
+    let under_rows: Vec<&Measure> = rows.iter().filter_map(|r| r.without.as_ref()).collect();
+    if !under_rows.is_empty() {
+        println!(
+            "  the generated motion under them, without the postures: foot skating mean {:.3} \
+             ({} of {} above the real {:.3})",
+            under_rows.iter().map(|m| m.skating).sum::<f64>() / under_rows.len() as f64,
+            under_rows
+                .iter()
+                .filter(|m| m.skating > real.skating)
+                .count(),
+            under_rows.len(),
+            real.skating
         );
     }
     println!(
