@@ -35,4 +35,9 @@ build_page() {
     "$target_dir/wasm32-unknown-unknown/release/coma_web.wasm"
   cp index.html dist/
   cp -r static dist/static
+  # gzip copies beside the files for hosts that serve them (`coma serve` does, as does nginx's
+  # gzip_static): the wasm travels at about a sixth of its size, the weights at about 0.9.
+  find dist -type f \( -name '*.wasm' -o -name '*.js' -o -name '*.html' -o -name '*.json' \
+    -o -name '*.bpk' -o -name '*.i8' -o -name '*.txt' -o -name '*.npy' \) \
+    -exec gzip -9 -k -f {} +
 }

@@ -31,12 +31,22 @@ fn seconds_of<T>(f: impl FnOnce() -> T) -> (T, f64) {
     (out, start.elapsed().as_secs_f64())
 }
 
+/// What to measure besides loading and one generation.
+#[derive(Clone, Copy, Debug)]
+pub struct BenchOptions {
+    /// Timed training steps per network (0 skips training).
+    pub train_steps: usize,
+    /// Times the base generation runs (the same seed each time); the median and the best are
+    /// reported, with achieved GFLOP/s.
+    pub repeats: usize,
+}
+
 /// Runs every measurement. `models` holds the default weights; with `config`, random weights
 /// of that size are measured instead.
 pub fn run_bench(
     models: &Path,
     config: Option<&SpamConfig>,
-    train_steps: usize,
+    options: BenchOptions,
 ) -> Result<Vec<BenchRow>> {
     let device = Device::flex();
     let mut rows = Vec::new();
@@ -78,25 +88,59 @@ pub fn run_bench(
     let (embedding, t) = seconds_of(|| text.encode(&[prompt]));
     rows.push(row("encode the prompt", t * 1e3, "ms"));
     let condition: [[f32; TEXT_DIM]; PARTS] = [embedding[0]; PARTS];
-    let options = SamplingOptions::default();
-    let mut rng = Rng::new(0);
+    let sampling = SamplingOptions::default();
     let n = 49;
     let fixed = vec![vec![None; n]; PARTS];
-    let (base, t) =
-        seconds_of(|| block_on(spam.decode_base(&condition, &fixed, &options, &mut rng)));
+    let mut times = Vec::new();
+    let mut base = Vec::new();
+    for _ in 0..options.repeats.max(1) {
+        let mut rng = Rng::new(0);
+        let (b, t) =
+            seconds_of(|| block_on(spam.decode_base(&condition, &fixed, &sampling, &mut rng)));
+        base = b;
+        times.push(t);
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let iterations = sampling.iterations as f64;
+    let gflop = iterations * spam.base_config.forward_flops(2, n) / 1e9;
     rows.push(row(
-        "base tokens, 196 frames (10 iterations)",
-        t * 1e3,
+        &format!(
+            "base tokens, 196 frames (10 guided iterations), median of {}",
+            times.len()
+        ),
+        median * 1e3,
         "ms",
     ));
+    if times.len() > 1 {
+        rows.push(row("base tokens, 196 frames, best", times[0] * 1e3, "ms"));
+    }
+    rows.push(row(
+        "matrix products of the base generation",
+        gflop,
+        "GFLOP",
+    ));
+    rows.push(row(
+        &format!(
+            "achieved at the median, {} threads",
+            rayon::current_num_threads()
+        ),
+        gflop / median,
+        "GFLOP/s",
+    ));
+    let mut rng = Rng::new(0);
     let (tokens, t) =
-        seconds_of(|| block_on(spam.decode_residual(&condition, base, None, &options, &mut rng)));
+        seconds_of(|| block_on(spam.decode_residual(&condition, base, None, &sampling, &mut rng)));
     if spam.residual.is_some() {
         rows.push(row("residual tokens, 196 frames", t * 1e3, "ms"));
     }
     let (_, t) = seconds_of(|| block_on(spam.decode(&tokens)));
     rows.push(row("decode tokens to features", t * 1e3, "ms"));
 
+    if options.train_steps == 0 {
+        return Ok(rows);
+    }
+    let train_steps = options.train_steps;
     let sizes = config.cloned().unwrap_or_else(|| {
         SpamConfig::new(spam.vq_config.clone(), spam.base_config.clone())
             .with_residual(spam.residual.as_ref().map(|r| r.config.clone()))

@@ -5,6 +5,7 @@
 
 pub mod edit;
 pub mod evaluator;
+pub mod gelu;
 pub mod generate;
 pub mod motion_model;
 pub mod tokens;

@@ -11,9 +11,12 @@ pub struct BenchArgs {
     /// the default model.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Timed training steps per network.
+    /// Timed training steps per network (0 measures inference only).
     #[arg(long, default_value_t = 3)]
     train_steps: usize,
+    /// Times the base generation runs; the median and the best are reported.
+    #[arg(long, default_value_t = 1)]
+    repeat: usize,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -27,7 +30,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
         ),
         None => None,
     };
-    let rows = coma::bench::run_bench(&args.model.models, sizes.as_ref(), args.train_steps)?;
+    let options = coma::bench::BenchOptions {
+        train_steps: args.train_steps,
+        repeats: args.repeat,
+    };
+    let rows = coma::bench::run_bench(&args.model.models, sizes.as_ref(), options)?;
     print!("{}", coma::bench::table(&rows));
     Ok(())
 }
