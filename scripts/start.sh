@@ -5,4 +5,5 @@ cd "$(dirname "$0")/.."
 . scripts/tools.sh
 ensure_rust_tools
 build_page
-exec cargo run --release -q -p coma -- serve dist --port "${PORT:-8080}"
+# The small server crate, not the engine: serving needs none of the model code.
+exec cargo run --release -q -p coma-serve -- dist --port "${PORT:-8080}"

@@ -46,7 +46,6 @@ pub mod posecodes;
 pub mod posture;
 pub mod render;
 pub mod rng;
-pub mod serve;
 pub mod session;
 pub mod share;
 pub mod skeleton;

@@ -1,6 +1,6 @@
-//! `coma serve`: the built page on localhost.
+//! `coma serve`: the built page on localhost (the `coma-serve` crate's server).
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -14,12 +14,5 @@ pub struct ServeArgs {
 }
 
 pub fn run(args: ServeArgs) -> Result<()> {
-    if !args.dir.join("index.html").exists() {
-        bail!(
-            "{} has no index.html: build the page first (see README.md)",
-            args.dir.display()
-        );
-    }
-    coma::serve::serve(&args.dir, args.port)?;
-    Ok(())
+    coma_serve::serve_page(&args.dir, args.port)
 }

@@ -142,6 +142,17 @@ fn entity_tag(bytes: &[u8]) -> String {
     format!("\"{:x}-{h:016x}\"", bytes.len())
 }
 
+/// Serves the built page in `root` (it must hold `index.html`) until the process is stopped.
+pub fn serve_page(root: &Path, port: u16) -> Result<()> {
+    if !root.join("index.html").exists() {
+        anyhow::bail!(
+            "{} has no index.html: build the page first (see README.md)",
+            root.display()
+        );
+    }
+    serve(root, port)
+}
+
 /// Serves `root` on `127.0.0.1:port` until the process is stopped.
 pub fn serve(root: &Path, port: u16) -> Result<()> {
     let listener = TcpListener::bind(("127.0.0.1", port))
