@@ -676,3 +676,41 @@ test("a path drawn on the ground with the pointer is walked, undone, redone and 
     await stop(server);
   }
 });
+
+test("a 196-frame motion without review, timed cold and warm on the CPU backend", { timeout: 30 * 60_000 }, async () => {
+  // Prints what issue 18's page figures are read from; no bar is asserted (the machine is
+  // shared and noisy): the figures go to MODEL_CARD.md with the run they came from.
+  const server = serve();
+  const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
+  try {
+    await waitForServer();
+    const opened = await open(await browser.newContext({ viewport: { width: 1280, height: 800 } }), BASE);
+    const { page } = opened;
+    await modelLoaded(page);
+    await page.fill("#prompt", "a person walks forward");
+    await page.fill("#seconds", "9.8");
+    await page.locator("#seconds").dispatchEvent("change");
+    await page.selectOption("#rounds", "0");
+    const times = [];
+    for (const seed of [1, 2, 3]) {
+      await page.fill("#seed", String(seed));
+      await page.locator("#seed").dispatchEvent("change");
+      const before = await jointsHash(page);
+      const started = Date.now();
+      await page.click("#generate");
+      await page.waitForFunction((h) => {
+        const v = document.querySelector(".viewer");
+        return v?.dataset.jointsHash && v.dataset.jointsHash !== h && !document.querySelector("#generate").disabled;
+      }, before, { timeout: LOAD_TIMEOUT });
+      times.push((Date.now() - started) / 1000);
+      const frames = Number(await page.locator(".viewer").getAttribute("data-frames"));
+      assert.ok(Math.abs(frames - 196) <= 4, `asked 196 frames, got ${frames}`);
+    }
+    console.log(`196 frames without review on ${await page.locator("#model-line").textContent()}: ` +
+      `first ${times[0].toFixed(2)} s, then ${times.slice(1).map((t) => t.toFixed(2)).join(" s, ")} s (warm)`);
+    assert.deepEqual(opened.problems, [], "errors in the browser console");
+  } finally {
+    await browser.close();
+    await stop(server);
+  }
+});
