@@ -96,25 +96,36 @@ async function shows(page, hash) {
     && !document.querySelector("#generate").disabled, hash, { timeout: LOAD_TIMEOUT });
 }
 
-/** Fills the prompt box: a short walk with `seed`, no review round. */
-async function walkPrompt(page, seed) {
-  await page.fill("#prompt", "a person walks forward");
-  await page.fill("#seconds", "2");
+/** Fills the prompt box with `prompt`, `seconds` ("" for the plan's own length) and `seed`,
+ * no review round. */
+async function fillPrompt(page, prompt, seconds, seed) {
+  await page.fill("#prompt", prompt);
+  await page.fill("#seconds", seconds);
   await page.locator("#seconds").dispatchEvent("change");
   await page.selectOption("#rounds", "0");
   await page.fill("#seed", String(seed));
   await page.locator("#seed").dispatchEvent("change");
 }
 
-/** Generates a short walk with `seed`; returns its joints hash and share link's fragment. */
-async function walk(page, seed) {
+/** Fills the prompt box: a short walk with `seed`, no review round. */
+async function walkPrompt(page, seed) {
+  await fillPrompt(page, "a person walks forward", "2", seed);
+}
+
+/** Presses Generate and waits until the page shows a new motion and is idle again. */
+async function generateNew(page) {
   const before = await jointsHash(page);
-  await walkPrompt(page, seed);
   await page.click("#generate");
   await page.waitForFunction((h) => {
     const v = document.querySelector(".viewer");
     return v?.dataset.jointsHash && v.dataset.jointsHash !== h && !document.querySelector("#generate").disabled;
   }, before, { timeout: LOAD_TIMEOUT });
+}
+
+/** Generates a short walk with `seed`; returns its joints hash and share link's fragment. */
+async function walk(page, seed) {
+  await walkPrompt(page, seed);
+  await generateNew(page);
   await page.click("#share");
   const link = await page.locator("#share-link").inputValue();
   return { hash: await jointsHash(page), fragment: link.slice(link.indexOf("#")) };
@@ -411,12 +422,7 @@ test("a posture prompt shows its key poses, and its share link rebuilds the same
     await modelLoaded(page);
 
     // No LLM: the built-in planner makes the squat in a T-pose a posture segment.
-    await page.fill("#prompt", "A person squats while striking a T-pose, then walks forward");
-    await page.fill("#seconds", "");
-    await page.locator("#seconds").dispatchEvent("change");
-    await page.selectOption("#rounds", "0");
-    await page.fill("#seed", "0");
-    await page.locator("#seed").dispatchEvent("change");
+    await fillPrompt(page, "A person squats while striking a T-pose, then walks forward", "", 0);
     let started = Date.now();
     await page.click("#generate");
     await page.waitForFunction(() => document.querySelector(".viewer")?.dataset.jointsHash
@@ -687,21 +693,11 @@ test("a 196-frame motion without review, timed cold and warm on the CPU backend"
     const opened = await open(await browser.newContext({ viewport: { width: 1280, height: 800 } }), BASE);
     const { page } = opened;
     await modelLoaded(page);
-    await page.fill("#prompt", "a person walks forward");
-    await page.fill("#seconds", "9.8");
-    await page.locator("#seconds").dispatchEvent("change");
-    await page.selectOption("#rounds", "0");
     const times = [];
     for (const seed of [1, 2, 3]) {
-      await page.fill("#seed", String(seed));
-      await page.locator("#seed").dispatchEvent("change");
-      const before = await jointsHash(page);
+      await fillPrompt(page, "a person walks forward", "9.8", seed);
       const started = Date.now();
-      await page.click("#generate");
-      await page.waitForFunction((h) => {
-        const v = document.querySelector(".viewer");
-        return v?.dataset.jointsHash && v.dataset.jointsHash !== h && !document.querySelector("#generate").disabled;
-      }, before, { timeout: LOAD_TIMEOUT });
+      await generateNew(page);
       times.push((Date.now() - started) / 1000);
       const frames = Number(await page.locator(".viewer").getAttribute("data-frames"));
       assert.ok(Math.abs(frames - 196) <= 4, `asked 196 frames, got ${frames}`);
