@@ -136,6 +136,19 @@ fn grouped_edits(segment: &Segment) -> Vec<(String, Vec<BodyPart>)> {
     groups
 }
 
+/// Each part a review corrects, with the instruction of the last correction naming it (as
+/// if the corrections were applied one after another).
+fn round_edits(review: &Review) -> Vec<(BodyPart, String)> {
+    let mut edits: Vec<(BodyPart, String)> = Vec::new();
+    for c in &review.corrections {
+        for part in c.region.parts() {
+            edits.retain(|(p, _)| p != part);
+            edits.push((*part, c.instruction.clone()));
+        }
+    }
+    edits
+}
+
 /// Runs the loop over `plan`. `scorer` (the evaluator) judges without an LLM and keeps a
 /// correction only when it does not lower the score; `llm` judges when given.
 pub async fn run<T: Transport>(
@@ -242,28 +255,24 @@ pub async fn run<T: Transport>(
                 });
                 break;
             }
-            let mut candidate = tokens.clone();
-            let mut edits = Vec::new();
-            for (k, c) in review.corrections.iter().enumerate() {
-                let seed = seed_of(options.seed, index, 100 + 10 * round as u64 + k as u64);
-                candidate = model
-                    .edit_parts(
-                        &candidate,
-                        &c.instruction,
-                        c.region.parts(),
-                        &segment.base,
-                        seed,
-                    )
-                    .await;
-                edits.push(Edit {
+            // Every correction of the round in one generation, each part conditioned on its
+            // own instruction: one generation per round, not one per corrected region.
+            let seed = seed_of(options.seed, index, 100 + 10 * round as u64);
+            let candidate = model
+                .edit_parts_each(&tokens, &round_edits(&review), &segment.base, seed)
+                .await;
+            let edits: Vec<Edit> = review
+                .corrections
+                .iter()
+                .map(|c| Edit {
                     kind: EditKind::BodyParts,
                     text: c.instruction.clone(),
                     from_frame: range.0,
                     to_frame: range.1,
                     parts: part_bits(c.region.parts()),
                     seed,
-                });
-            }
+                })
+                .collect();
             let decoded = model.spam.decode(&candidate).await;
             let after = scorer.map(|s| s.segment_score(segment, &decoded));
             let accepted = match (current, after) {
@@ -575,6 +584,44 @@ mod tests {
         );
         assert_eq!(part_bits(&groups[0].1), 0b0011);
         assert_eq!(part_bits(&[BodyPart::RightLeg]), 0b1000);
+    }
+
+    #[test]
+    fn a_rounds_corrections_become_one_edit_with_an_instruction_per_part() {
+        use crate::agents::reviewer::{Correction, JudgeKind, Region};
+        let correction = |region, instruction: &str| Correction {
+            region,
+            instruction: instruction.into(),
+        };
+        let review = Review {
+            description: String::new(),
+            scores: Vec::new(),
+            corrections: vec![
+                correction(Region::LeftArm, "a person waves"),
+                correction(Region::LowerBody, "a person squats"),
+                correction(Region::LeftArm, "a person raises the left hand"),
+            ],
+            judge: JudgeKind::Evaluator,
+            note: None,
+        };
+        let edits = round_edits(&review);
+        let text_of = |part| {
+            let found: Vec<&String> = edits
+                .iter()
+                .filter(|(p, _)| *p == part)
+                .map(|(_, t)| t)
+                .collect();
+            found
+        };
+        assert_eq!(edits.len(), 3, "{edits:?}");
+        assert_eq!(
+            text_of(BodyPart::LeftArm),
+            ["a person raises the left hand"]
+        );
+        assert!(text_of(BodyPart::RightArm).is_empty());
+        for leg in Region::LowerBody.parts() {
+            assert_eq!(text_of(*leg), ["a person squats"]);
+        }
     }
 
     #[test]

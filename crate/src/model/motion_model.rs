@@ -142,15 +142,29 @@ impl MotionModel {
         rest: &str,
         seed: u64,
     ) -> MotionTokens {
-        let overrides: Vec<_> = parts
+        let edits: Vec<_> = parts
             .iter()
             .map(|p| (*p, instruction.to_string()))
             .collect();
+        self.edit_parts_each(tokens, &edits, rest, seed).await
+    }
+
+    /// Each part of `edits` regenerated from its own instruction, all in one generation (the
+    /// text condition is per part); a part named twice takes its first instruction. The other
+    /// parts keep their tokens and are conditioned on `rest`.
+    pub async fn edit_parts_each(
+        &self,
+        tokens: &MotionTokens,
+        edits: &[(BodyPart, String)],
+        rest: &str,
+        seed: u64,
+    ) -> MotionTokens {
+        let parts: Vec<BodyPart> = edits.iter().map(|(p, _)| *p).collect();
         self.spam
             .edit_parts(
                 tokens,
-                &self.condition(rest, &overrides),
-                parts,
+                &self.condition(rest, edits),
+                &parts,
                 &sampling(seed),
             )
             .await
