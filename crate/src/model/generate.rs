@@ -2,11 +2,10 @@
 //! classifier-free guidance, and seeded sampling done in plain Rust so a seed gives the same
 //! motion on every backend.
 
+use super::guidance::{Pass, PassInputs};
 use super::transformer::{PARTS, TEXT_DIM};
 use super::{Residual, Spam};
 use crate::rng::Rng;
-use burn::prelude::*;
-use burn::tensor::{Bool, Int, TensorData};
 
 /// How to sample.
 #[derive(Clone, Debug)]
@@ -94,58 +93,6 @@ fn sample(logits: &[f32], options: &SamplingOptions, rng: &mut Rng) -> (u32, f32
     (last as u32, p[last])
 }
 
-/// Guided logits `[4, N, K]` on the CPU: `(1 + s)·cond − s·uncond`, from a batch of two
-/// (conditional first).
-async fn guided(logits: Tensor<4>, scale: f32) -> Vec<f32> {
-    let [_, p, n, k] = logits.dims();
-    let v = super::read_floats(logits).await;
-    let (cond, uncond) = v.split_at(p * n * k);
-    cond.iter()
-        .zip(uncond)
-        .map(|(c, u)| (1.0 + scale) * c - scale * u)
-        .collect()
-}
-
-/// Inputs shared by every call of one motion: text `[1, 4, 384]` and no padding `[1, N]`.
-fn conditions(
-    text: &[[f32; TEXT_DIM]; PARTS],
-    n: usize,
-    device: &Device,
-) -> (Tensor<3>, Tensor<2, Bool>) {
-    let flat: Vec<f32> = text.iter().flatten().copied().collect();
-    let text = Tensor::<3>::from_data(TensorData::new(flat, [1, PARTS, TEXT_DIM]), device);
-    let pad = Tensor::<2, Int>::zeros([1, n], device).equal_elem(1);
-    (text, pad)
-}
-
-/// Logits `[2, 4, N, K]` of classifier-free guidance's two passes, conditional first.
-/// `forward(copies, keep)` runs the network on `copies` copies of one motion's inputs with
-/// keep-text flags `keep` `[copies, 4]` (1 keeps the text, 0 drops it).
-///
-/// On the CPU device natively the two passes run at once, one per core (`rayon::join`), and
-/// give the same logits as one batch of two. burn's CPU backend threads each operation on
-/// its own, and at these sizes (a few hundred rows) waking and joining the threads around
-/// every product costs much of the time (`perf` on `coma bench`: 13 % in system calls, futex
-/// and sched_yield); two whole passes side by side took about 0.65× the time of one batch of
-/// two. Elsewhere (WebGPU, the page's single thread) one batch of two is one pass.
-fn guidance_pair<F>(device: &Device, forward: F) -> Tensor<4>
-where
-    F: Fn(usize, Tensor<2>) -> Tensor<4> + Sync,
-{
-    let keep = |value: f32, copies: usize| {
-        Tensor::<2>::from_data(
-            TensorData::new(vec![value; copies * PARTS], [copies, PARTS]),
-            device,
-        )
-    };
-    #[cfg(not(target_arch = "wasm32"))]
-    if *device == Device::flex() {
-        let (cond, uncond) = rayon::join(|| forward(1, keep(1.0, 1)), || forward(1, keep(0.0, 1)));
-        return Tensor::cat(vec![cond, uncond], 0);
-    }
-    forward(2, Tensor::cat(vec![keep(1.0, 1), keep(0.0, 1)], 0))
-}
-
 impl Spam {
     /// Fills the masked layer-0 tokens by iterative unmasking. `fixed[p][n]` holds tokens that
     /// must stay (editing); `None` everywhere generates from scratch. Returns `[part][step]`.
@@ -156,11 +103,11 @@ impl Spam {
         options: &SamplingOptions,
         rng: &mut Rng,
     ) -> Vec<Vec<u32>> {
-        let (model, config, device) = (&self.base, &self.base_config, &self.device);
+        let (config, device) = (&self.base_config, &self.device);
         let n = fixed[0].len();
         let k = config.codebook_size;
         let mask = config.mask_id() as u32;
-        let (text_t, pad) = conditions(text, n, device);
+        let inputs = PassInputs::new(text, n, device);
         let mut ids: Vec<u32> = fixed
             .iter()
             .flat_map(|p| p.iter().map(|t| t.unwrap_or(mask)))
@@ -184,17 +131,14 @@ impl Spam {
                 }
             }
             let remasked: Vec<usize> = order.into_iter().take(still).collect();
-            let batch: Vec<i32> = ids.iter().map(|t| *t as i32).collect();
-            let tokens = Tensor::<3, Int>::from_data(TensorData::new(batch, [1, PARTS, n]), device);
-            let pair = guidance_pair(device, |copies, keep| {
-                model.forward(
-                    tokens.clone().repeat_dim(0, copies),
-                    text_t.clone().repeat_dim(0, copies),
-                    keep,
-                    pad.clone().repeat_dim(0, copies),
-                )
-            });
-            let logits = guided(pair, options.base_guidance).await;
+            let pass = Pass {
+                layer: 0,
+                steps: n,
+                tokens: ids.iter().map(|t| *t as i32).collect(),
+            };
+            let logits = self
+                .guided_logits(&pass, &inputs, options.base_guidance)
+                .await;
             for i in remasked {
                 let (code, p) = sample(&logits[i * k..(i + 1) * k], options, rng);
                 ids[i] = code;
@@ -216,37 +160,25 @@ impl Spam {
         rng: &mut Rng,
     ) -> MotionTokens {
         let mut layers: Vec<Vec<Vec<u32>>> = base.into_iter().map(|b| vec![b]).collect();
-        let Some(Residual {
-            network: model,
-            config,
-        }) = &self.residual
-        else {
+        let Some(Residual { config, .. }) = &self.residual else {
             return MotionTokens::from_model(layers);
         };
         let device = &self.device;
         let n = layers[0][0].len();
         let k = config.codebook_size;
-        let (text_t, pad) = conditions(text, n, device);
+        let inputs = PassInputs::new(text, n, device);
         for j in 1..config.vq_layers {
-            let flat: Vec<i32> = layers
-                .iter()
-                .flat_map(|part| {
-                    part.iter()
-                        .flat_map(|layer| layer.iter().map(|t| *t as i32))
-                })
-                .collect();
-            let lower =
-                Tensor::<4, Int>::from_data(TensorData::new(flat, [1, PARTS, j, n]), device);
-            let pair = guidance_pair(device, |copies, keep| {
-                model.forward(
-                    lower.clone().repeat_dim(0, copies),
-                    j,
-                    text_t.clone().repeat_dim(0, copies),
-                    keep,
-                    pad.clone().repeat_dim(0, copies),
-                )
-            });
-            let logits = guided(pair, options.residual_guidance).await;
+            let pass = Pass {
+                layer: j,
+                steps: n,
+                tokens: layers
+                    .iter()
+                    .flat_map(|part| part.iter().flat_map(|l| l.iter().map(|t| *t as i32)))
+                    .collect(),
+            };
+            let logits = self
+                .guided_logits(&pass, &inputs, options.residual_guidance)
+                .await;
             for (p, part) in layers.iter_mut().enumerate() {
                 let row: Vec<u32> = (0..n)
                     .map(|s| {
@@ -276,6 +208,7 @@ pub struct KeepResidual<'a> {
 pub(crate) mod tests {
     use super::*;
     use crate::executor::block_on;
+    use burn::tensor::Device;
 
     #[test]
     fn schedule_goes_from_all_to_none() {
@@ -324,40 +257,6 @@ pub(crate) mod tests {
             .with_codebook_size(16)
             .with_layers(3)
             .with_res_blocks(1)
-    }
-
-    #[test]
-    fn the_guidance_pair_gives_the_logits_of_one_batch_of_two() {
-        let device = Device::flex();
-        let model = crate::model::transformer::BaseTransformer::new(&small(), &device);
-        let (text, pad) = conditions(&[[0.3f32; TEXT_DIM]; PARTS], 5, &device);
-        let ids: Vec<i32> = (0..PARTS as i32 * 5).map(|i| i % 17).collect();
-        let tokens = Tensor::<3, Int>::from_data(TensorData::new(ids, [1, PARTS, 5]), &device);
-        let run = |copies: usize, keep: Tensor<2>| {
-            model.forward(
-                tokens.clone().repeat_dim(0, copies),
-                text.clone().repeat_dim(0, copies),
-                keep,
-                pad.clone().repeat_dim(0, copies),
-            )
-        };
-        let pair = guidance_pair(&device, run);
-        let keep = Tensor::<2>::from_data(
-            TensorData::new([[1.0f32; PARTS], [0.0; PARTS]].concat(), [2, PARTS]),
-            &device,
-        );
-        let batch = run(2, keep);
-        assert_eq!(pair.dims(), [2, PARTS, 5, 16]);
-        let (a, b) = (
-            block_on(super::super::read_floats(pair)),
-            block_on(super::super::read_floats(batch)),
-        );
-        assert_eq!(a, b, "the same logits, bit for bit");
-        assert_ne!(
-            a[..a.len() / 2],
-            b[b.len() / 2..],
-            "the text changes the logits"
-        );
     }
 
     #[test]

@@ -7,6 +7,7 @@ pub mod edit;
 pub mod evaluator;
 pub mod gelu;
 pub mod generate;
+pub mod guidance;
 pub mod motion_model;
 pub mod tokens;
 pub mod transformer;
@@ -41,6 +42,9 @@ pub struct Spam {
     /// (coarser: see MODEL_CARD.md for the reconstruction error of one layer).
     pub residual: Option<Residual>,
     pub device: Device,
+    /// Where guidance's unconditional pass runs besides here (the page's second worker);
+    /// `None` runs both passes on this device (see [`guidance`]).
+    pub partner: Option<std::rc::Rc<dyn guidance::GuidancePartner>>,
 }
 
 /// The residual transformer and its sizes.
@@ -69,6 +73,7 @@ impl Spam {
                 config: config.clone(),
             }),
             device: device.clone(),
+            partner: None,
         }
     }
 
