@@ -23,10 +23,28 @@ pub struct ModelInfo {
     pub id: String,
     pub backend: Backend,
     pub note: Option<String>,
+    /// Workers generating (2 with the guidance partner on the CPU backend).
+    pub workers: u32,
     pub bytes: u64,
     pub millis: f64,
     /// What did not load, and what the page does without it.
     pub missing: Vec<String>,
+}
+
+impl ModelInfo {
+    /// Where the model runs, for the user: "WebGPU", "the CPU (2 workers)", with the reason
+    /// when it is not WebGPU or not two workers.
+    pub fn runs_on(&self) -> String {
+        match (self.backend, &self.note) {
+            (Backend::WebGpu, _) => "WebGPU".to_string(),
+            (Backend::Cpu, note) => format!(
+                "the CPU ({} worker{}{})",
+                self.workers,
+                if self.workers == 1 { "" } else { "s" },
+                note.as_ref().map_or(String::new(), |n| format!("; {n}"))
+            ),
+        }
+    }
 }
 
 /// A line for the user: what happened, or what went wrong and what to do.
@@ -188,34 +206,34 @@ fn on_reply(state: AppState, reply: Reply) {
             model_id,
             backend,
             note,
+            workers,
             bytes,
             millis,
             missing,
         } => {
             state.progress.set(None);
-            state.say(format!(
-                "Model {model_id} loaded ({:.1} MB in {:.1} s) on {}{}. Type a prompt and press Generate.",
-                bytes as f64 / 1e6,
-                millis / 1000.0,
-                match (backend, &note) {
-                    (Backend::WebGpu, _) => "WebGPU".to_string(),
-                    (Backend::Cpu, Some(why)) => format!("the CPU ({why})"),
-                    (Backend::Cpu, None) => "the CPU".to_string(),
-                },
-                if missing.is_empty() {
-                    String::new()
-                } else {
-                    format!("; not loaded: {}", missing.join("; "))
-                }
-            ));
-            state.model.set(Some(ModelInfo {
+            let info = ModelInfo {
                 id: model_id,
                 backend,
                 note,
+                workers,
                 bytes,
                 millis,
                 missing,
-            }));
+            };
+            state.say(format!(
+                "Model {} loaded ({:.1} MB in {:.1} s) on {}{}. Type a prompt and press Generate.",
+                info.id,
+                info.bytes as f64 / 1e6,
+                info.millis / 1000.0,
+                info.runs_on(),
+                if info.missing.is_empty() {
+                    String::new()
+                } else {
+                    format!("; not loaded: {}", info.missing.join("; "))
+                }
+            ));
+            state.model.set(Some(info));
             open_link(state);
         }
         Reply::Progress {

@@ -1,6 +1,7 @@
 //! The page: a Leptos app (the UI, on the main thread) and an inference worker (the models,
 //! in a Web Worker), built from this one wasm module. [`start`] mounts the app in a window;
-//! [`worker_main`] is called by `static/worker.js` inside the worker.
+//! [`worker_main`] is called by `static/worker.js` inside the worker, [`partner_main`] inside
+//! the worker's guidance partner.
 //!
 //! The modules without a browser in them (messages, the worker's dispatch, history, takes,
 //! exports, the viewer's scene) build and test natively; the rest only for wasm32.
@@ -20,6 +21,8 @@ mod browser;
 mod client;
 #[cfg(target_arch = "wasm32")]
 mod llm_fetch;
+#[cfg(target_arch = "wasm32")]
+mod partner;
 #[cfg(target_arch = "wasm32")]
 mod ui;
 #[cfg(target_arch = "wasm32")]
@@ -44,4 +47,12 @@ pub fn start() {
 #[wasm_bindgen]
 pub fn worker_main() {
     worker::start();
+}
+
+/// The guidance partner's entry point: `static/worker.js` started by the inference worker in
+/// its partner role (see `partner.rs`).
+#[cfg(target_arch = "wasm32")]
+#[wasm_bindgen]
+pub fn partner_main() {
+    partner::serve();
 }

@@ -90,8 +90,13 @@ pub enum Reply {
     Loaded {
         model_id: String,
         backend: Backend,
-        /// Why WebGPU is not used, when it is not.
+        /// Why WebGPU is not used, when it is not (and why one worker, when the CPU backend
+        /// runs on one).
         note: Option<String>,
+        /// Workers generating on the CPU backend: 2 with the guidance partner (two cores),
+        /// else 1; 1 on WebGPU too.
+        #[serde(default = "one")]
+        workers: u32,
         bytes: u64,
         millis: f64,
         /// What did not load and what the page does without it (no evaluator: no review; no
@@ -105,6 +110,11 @@ pub enum Reply {
     Done { outcome: Outcome, millis: f64 },
     /// The request failed; the page keeps its last good state.
     Error { message: String },
+}
+
+/// Serde's default for counts that older messages did not carry.
+fn one() -> u32 {
+    1
 }
 
 /// Encodes a message for `postMessage`.
@@ -175,6 +185,7 @@ mod tests {
             model_id: "0123456789abcdef".into(),
             backend: Backend::Cpu,
             note: Some("no WebGPU adapter".into()),
+            workers: 2,
             bytes: 10,
             millis: 1.5,
             missing: vec![],

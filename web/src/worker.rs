@@ -6,8 +6,10 @@
 
 use crate::llm_fetch::FetchTransport;
 use crate::messages::{from_json, to_json, Backend, LlmSettings, Reply, Request};
+use crate::partner::PartnerWorker;
 use coma::agents::llm::LlmClient;
 use coma::model::evaluator::Evaluator;
+use coma::model::guidance::GuidancePartner;
 use coma::model::motion_model::TextFiles;
 use coma::model::{MotionModel, SpamConfig, SpamFiles, RESIDUAL_FILE};
 use coma::session::{Command, Session, VOCABULARY_FILE};
@@ -191,11 +193,31 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
     };
     let config = std::str::from_utf8(&config_bytes)
         .map_err(|_| "spam.json is not UTF-8 text".to_string())?;
-    let (device, backend, note) = choose_device(asked).await;
+    let (device, backend, mut note) = choose_device(asked).await;
+    // On the CPU a second worker runs guidance's unconditional passes (see partner.rs); it
+    // loads its copy of the transformers while this one loads the rest.
+    let partner = match backend {
+        Backend::WebGpu => None,
+        Backend::Cpu if cores() < 2 => {
+            note = Some(join_notes(note, "one worker: the browser reports one core"));
+            None
+        }
+        Backend::Cpu => match PartnerWorker::spawn(
+            config,
+            file("base.bpk"),
+            files.get(RESIDUAL_FILE).map(Vec::as_slice),
+        ) {
+            Ok(partner) => Some(Rc::new(partner)),
+            Err(e) => {
+                note = Some(join_notes(note, &format!("one worker: {e}")));
+                None
+            }
+        },
+    };
     // The sentence encoder and the evaluator stay on the CPU: they answer synchronous calls
     // of the planner and the reviewer, and are quick there.
     let cpu = burn::tensor::Device::flex();
-    let model = MotionModel::from_files(
+    let mut model = MotionModel::from_files(
         &SpamFiles {
             config,
             vq: file("vq.bpk"),
@@ -213,6 +235,8 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
         &cpu,
     )
     .map_err(|e| format!("the model does not load: {e}"))?;
+    let workers = 1 + partner.is_some() as u32;
+    model.spam.partner = partner.map(|p| p as Rc<dyn GuidancePartner>);
     let evaluator = match evaluator_files {
         [Ok(config), Ok(weights)] => std::str::from_utf8(&config)
             .map_err(|_| "evaluator.json is not UTF-8 text".to_string())
@@ -231,10 +255,27 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
         model_id,
         backend,
         note,
+        workers,
         bytes,
         millis: now() - started,
         missing,
     })
+}
+
+/// Logical cores the browser reports (`navigator.hardwareConcurrency`; 1 if it does not say).
+fn cores() -> u32 {
+    js_sys::Reflect::get(&scope(), &"navigator".into())
+        .and_then(|n| js_sys::Reflect::get(&n, &"hardwareConcurrency".into()))
+        .ok()
+        .and_then(|c| c.as_f64())
+        .map_or(1, |c| c as u32)
+}
+
+fn join_notes(note: Option<String>, more: &str) -> String {
+    match note {
+        Some(note) => format!("{note}; {more}"),
+        None => more.to_string(),
+    }
 }
 
 fn session() -> Result<Rc<Session>, String> {

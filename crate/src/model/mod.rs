@@ -187,29 +187,42 @@ impl Spam {
         files: &SpamFiles,
         device: &Device,
     ) -> Result<(Spam, crate::features::Normalizer), SpamLoadError> {
-        let error = |file: &str, message: String| SpamLoadError::File {
-            file: file.to_string(),
-            message,
-        };
+        let mut spam =
+            Spam::transformers_from_bytes(files.config, files.base, files.residual, device)?;
+        spam.vq =
+            crate::weights::load_into(spam.vq, files.vq).map_err(|e| file_error("vq.bpk", e))?;
+        let normalizer = crate::features::Normalizer::from_npy_bytes(files.mean, files.std)
+            .map_err(|e| file_error("mean.npy/std.npy", e.to_string()))?;
+        Ok((spam, normalizer))
+    }
+
+    /// SPAM with its transformers' weights from `spam.json`, `base.bpk` and `residual.bpk`
+    /// (`None` for a base-only model) and the VQ-VAE left random: all a guidance partner
+    /// needs (see [`guidance`]).
+    pub fn transformers_from_bytes(
+        config: &str,
+        base: &[u8],
+        residual: Option<&[u8]>,
+        device: &Device,
+    ) -> Result<Spam, SpamLoadError> {
         let config: SpamConfig =
-            serde_json::from_str(files.config).map_err(|e| error("spam.json", e.to_string()))?;
+            serde_json::from_str(config).map_err(|e| file_error("spam.json", e.to_string()))?;
         let mut spam = Spam::random(&config.vq, &config.base, config.residual.as_ref(), device);
-        spam.vq = crate::weights::load_into(spam.vq, files.vq).map_err(|e| error("vq.bpk", e))?;
         spam.base =
-            crate::weights::load_into(spam.base, files.base).map_err(|e| error("base.bpk", e))?;
-        match (spam.residual.as_mut(), files.residual) {
+            crate::weights::load_into(spam.base, base).map_err(|e| file_error("base.bpk", e))?;
+        match (spam.residual.as_mut(), residual) {
             (Some(residual), Some(bytes)) => {
                 residual.network = crate::weights::load_into(residual.network.clone(), bytes)
-                    .map_err(|e| error(RESIDUAL_FILE, e))?;
+                    .map_err(|e| file_error(RESIDUAL_FILE, e))?;
             }
             (Some(_), None) => {
-                return Err(error(
+                return Err(file_error(
                     RESIDUAL_FILE,
                     "missing, but spam.json sizes a residual transformer".into(),
                 ))
             }
             (None, Some(_)) => {
-                return Err(error(
+                return Err(file_error(
                     RESIDUAL_FILE,
                     "present, but spam.json has no residual transformer (\"residual\": null)"
                         .into(),
@@ -217,9 +230,7 @@ impl Spam {
             }
             (None, None) => {}
         }
-        let normalizer = crate::features::Normalizer::from_npy_bytes(files.mean, files.std)
-            .map_err(|e| error("mean.npy/std.npy", e.to_string()))?;
-        Ok((spam, normalizer))
+        Ok(spam)
     }
 
     /// Loads `spam.json`, `vq.bpk`, `base.bpk`, `residual.bpk` (unless base-only) and the
@@ -257,5 +268,12 @@ impl Spam {
                 }
             })?;
         Ok((spam, normalizer, files.id()))
+    }
+}
+
+fn file_error(file: &str, message: String) -> SpamLoadError {
+    SpamLoadError::File {
+        file: file.to_string(),
+        message,
     }
 }

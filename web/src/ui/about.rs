@@ -2,7 +2,6 @@
 //! it (the default weights inherit CC BY-NC 4.0 from their training data).
 
 use crate::app::AppState;
-use crate::messages::Backend;
 use leptos::prelude::*;
 
 #[component]
@@ -13,14 +12,10 @@ pub fn About() -> impl IntoView {
             None => "The model is loading.".to_string(),
             Some(m) => {
                 format!(
-                    "Model {} ({:.1} MB), running on {}{}.",
+                    "Model {} ({:.1} MB), running on {}.",
                     m.id,
                     m.bytes as f64 / 1e6,
-                    match m.backend {
-                        Backend::WebGpu => "WebGPU",
-                        Backend::Cpu => "the CPU",
-                    },
-                    m.note.as_ref().map_or(String::new(), |n| format!(": {n}"))
+                    m.runs_on()
                 ) + &m
                     .missing
                     .iter()
