@@ -22,6 +22,9 @@ import { existsSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { homedir, tmpdir } from "node:os";
 import { join, resolve } from "node:path";
 import { chromium } from "playwright-core";
+import {
+  ARGS, PLAIN_ARGS, LOAD_TIMEOUT, modelLoaded, jointsHash, fillPrompt, generateNew, timeGenerations,
+} from "./page_driver.mjs";
 
 const here = new URL(".", import.meta.url).pathname;
 const DIST = resolve(process.env.DIST ?? join(here, "../dist"));
@@ -29,16 +32,6 @@ const COMA = process.env.COMA ?? "coma";
 const PORT = Number(process.env.PORT ?? 8097);
 const SHOTS = resolve(process.env.SHOTS ?? join(here, "../docs"));
 const BASE = `http://127.0.0.1:${PORT}/`;
-const LOAD_TIMEOUT = 10 * 60_000;
-
-// Software WebGPU (SwiftShader) for compute and canvas (ANGLE on SwiftShader too, or the
-// compositor shows WebGPU canvases blank in screenshots), and no calls out of the machine.
-const ARGS = [
-  "--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu-sandbox",
-  "--enable-unsafe-webgpu", "--enable-features=Vulkan", "--use-vulkan=swiftshader", "--use-angle=swiftshader",
-  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-  "--no-first-run", "--disable-quic",
-];
 
 /** Starts `coma serve` on PORT. */
 function serve() {
@@ -80,48 +73,15 @@ async function open(context, url) {
   return { page, problems, stats };
 }
 
-async function modelLoaded(page) {
-  await page.waitForFunction(() => {
-    const b = document.querySelector("#generate");
-    return b && !b.disabled;
-  }, null, { timeout: LOAD_TIMEOUT });
-}
-
-/** The joints hash of the motion the page shows ("" for none). */
-async function jointsHash(page) {
-  return (await page.locator(".viewer").getAttribute("data-joints-hash")) ?? "";
-}
-
 /** Waits until the page shows the motion whose joints hash is `hash` and is idle. */
 async function shows(page, hash) {
   await page.waitForFunction((h) => document.querySelector(".viewer")?.dataset.jointsHash === h
     && !document.querySelector("#generate").disabled, hash, { timeout: LOAD_TIMEOUT });
 }
 
-/** Fills the prompt box with `prompt`, `seconds` ("" for the plan's own length) and `seed`,
- * no review round. */
-async function fillPrompt(page, prompt, seconds, seed) {
-  await page.fill("#prompt", prompt);
-  await page.fill("#seconds", seconds);
-  await page.locator("#seconds").dispatchEvent("change");
-  await page.selectOption("#rounds", "0");
-  await page.fill("#seed", String(seed));
-  await page.locator("#seed").dispatchEvent("change");
-}
-
 /** Fills the prompt box: a short walk with `seed`, no review round. */
 async function walkPrompt(page, seed) {
   await fillPrompt(page, "a person walks forward", "2", seed);
-}
-
-/** Presses Generate and waits until the page shows a new motion and is idle again. */
-async function generateNew(page) {
-  const before = await jointsHash(page);
-  await page.click("#generate");
-  await page.waitForFunction((h) => {
-    const v = document.querySelector(".viewer");
-    return v?.dataset.jointsHash && v.dataset.jointsHash !== h && !document.querySelector("#generate").disabled;
-  }, before, { timeout: LOAD_TIMEOUT });
 }
 
 /** Generates a short walk with `seed`; returns its joints hash and share link's fragment. */
@@ -332,7 +292,7 @@ test("SPAM runs on the browser's WebGPU when the page is asked to", { timeout: 3
     console.log(`generated ${gpu.frames} frames on WebGPU (SwiftShader) in ${(gpu.millis / 1000).toFixed(1)} s in the page`);
     assert.ok(Math.abs(gpu.frames - 40) <= 4, `asked 40 frames, got ${gpu.frames}`);
     const cpu = await run("?backend=cpu", 2);
-    assert.match(cpu.status, /on the CPU \(the page asked for the CPU backend/);
+    assert.match(cpu.status, /on the CPU \([12] workers?; the page asked for the CPU backend/);
     // The same prompt and seed on both backends: floating-point sums in another order may
     // flip a close draw, so say whether the tokens agree rather than require it.
     const tokens = (link) => link.split("#")[1];
@@ -685,11 +645,6 @@ test("a path drawn on the ground with the pointer is walked, undone, redone and 
   }
 });
 
-// Chromium without the software WebGPU the other tests force: as on a machine without a GPU,
-// the page then runs on the CPU backend and draws with its 2D renderer, and SwiftShader does
-// not render the playing motion on the same two cores while the model generates.
-const PLAIN_ARGS = ARGS.filter((a) => !/webgpu|vulkan|angle/i.test(a));
-
 test("a 196-frame motion without review and the reviewed walk, timed on the CPU backend", { timeout: 30 * 60_000 }, async () => {
   // Prints what issue 18's page figures are read from; no bar is asserted (the machine is
   // shared and noisy): the figures go to MODEL_CARD.md with the run they came from.
@@ -700,19 +655,7 @@ test("a 196-frame motion without review and the reviewed walk, timed on the CPU 
     const opened = await open(await browser.newContext({ viewport: { width: 1280, height: 800 } }), BASE);
     const { page } = opened;
     await modelLoaded(page);
-    const timed = async (prompt, seed, rounds) => {
-      await fillPrompt(page, prompt, "9.8", seed);
-      if (rounds !== undefined) await page.selectOption("#rounds", rounds);
-      const started = Date.now();
-      await generateNew(page);
-      const frames = Number(await page.locator(".viewer").getAttribute("data-frames"));
-      assert.ok(Math.abs(frames - 196) <= 4, `asked 196 frames, got ${frames}`);
-      return ((Date.now() - started) / 1000).toFixed(2);
-    };
-    const plain = [];
-    for (const seed of [1, 2, 3]) plain.push(await timed("a person walks forward", seed));
-    const reviewed = [];
-    for (const seed of [4, 5]) reviewed.push(await timed("a person walks forward", seed, "2"));
+    const { plain, reviewed } = await timeGenerations(page);
     const modelLine = await page.locator("#model-line").textContent();
     // This machine has two cores: the guidance partner must have started beside the engine.
     assert.match(modelLine, /the CPU \(2 workers/);
