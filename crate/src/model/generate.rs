@@ -1,6 +1,6 @@
-//! Generation: iterative masked decoding of the base tokens, layer-by-layer residual tokens,
-//! classifier-free guidance, and seeded sampling done in plain Rust so a seed gives the same
-//! motion on every backend.
+//! Generation: iterative masked decoding of the base tokens, layer-by-layer residual tokens
+//! (each step guided, see [`super::guidance`]), and seeded sampling done in plain Rust so a
+//! seed gives the same motion on every backend.
 
 use super::guidance::{Pass, PassInputs};
 use super::transformer::{PARTS, TEXT_DIM};

@@ -1,7 +1,8 @@
 //! SPAM, the body-part-aware motion generator: the residual VQ-VAE ([`vq`]), the masked
 //! transformers that generate its tokens from text ([`transformer`]), sampling
-//! ([`generate`]) and editing ([`edit`]); beside it the text–motion evaluator ([`evaluator`]),
-//! the network that measures motions and judges them for the reviewer.
+//! ([`generate`]) with classifier-free guidance ([`guidance`]) and editing ([`edit`]);
+//! beside it the text–motion evaluator ([`evaluator`]), the network that measures motions
+//! and judges them for the reviewer.
 
 pub mod edit;
 pub mod evaluator;
