@@ -43,11 +43,11 @@ unsafe extern "C" {
 #[cfg(target_arch = "wasm32")]
 #[wasm_bindgen(start)]
 pub fn start() {
-    // Without this call the linker treats the module as a command and runs all ~4,900
+    // Without this call the linker treats the module as a command and runs all its
     // constructors again at the top of every export (the allocator, the JS-value table:
-    // thousands of calls a generation, 0.15–0.19 ms each; Chrome's profiler put a sixth of a
-    // warm generation there). Called here, from the start function every instance runs once
-    // before anything else, they run once.
+    // thousands of calls a generation), which a Chrome profile of the page showed as a large
+    // share of a warm generation. Called here, from the start function every instance runs
+    // once before anything else, they run once.
     // SAFETY: the linker's own function, called once per instance before any other export
     // of ours runs; the constructors it calls only fill registries.
     unsafe { __wasm_call_ctors() };

@@ -147,8 +147,9 @@ impl Spam {
     /// On the CPU device natively the two passes run at once, one per core (`rayon::join`).
     /// burn's CPU backend threads each operation on its own, and at these sizes (a few
     /// hundred rows) waking and joining the threads around every product costs much of the
-    /// time (`perf` on `coma bench`: 13 % in system calls, futex and sched_yield); two whole
-    /// passes side by side took about 0.65× the time of one batch of two. With a partner the
+    /// time (`perf record --call-graph dwarf coma bench --train-steps 0`: 13 % in system
+    /// calls); two whole passes side by side take about 0.6× the time of one batch of two
+    /// (`scripts/speed_reference.sh`, MODEL_CARD.md). With a partner the
     /// unconditional pass runs there (if it fails, here). Elsewhere (WebGPU, the page
     /// without a partner) one batch of two is one pass. All give the same logits, bit for bit
     /// on the CPU (tested).
