@@ -57,14 +57,27 @@ async function waitForServer() {
   throw new Error(`the page server did not start on ${BASE}`);
 }
 
+/** Console lines of each opened page. */
+const logs = new WeakMap();
+
 /** Opens the page and records console errors, uncaught errors and bytes received. */
 async function open(context, url) {
   const page = await context.newPage();
   const problems = [];
   const stats = { bytes: 0, outside: [] };
-  page.on("console", (m) => { if (m.type() === "error") problems.push(`console: ${m.text()}`); });
-  page.on("pageerror", (e) => problems.push(`uncaught: ${e.message}`));
-  page.on("worker", (w) => w.on("console", (m) => { if (m.type() === "error") problems.push(`worker console: ${m.text()}`); }));
+  // Every console line, the workers' too, kept for the message of a test that fails.
+  const log = [];
+  const keep = (line) => { log.push(line); if (log.length > 200) log.shift(); };
+  page.on("console", (m) => {
+    keep(`${m.type()}: ${m.text()}`);
+    if (m.type() === "error") problems.push(`console: ${m.text()}`);
+  });
+  page.on("pageerror", (e) => { keep(`uncaught: ${e.message}`); problems.push(`uncaught: ${e.message}`); });
+  page.on("worker", (w) => w.on("console", (m) => {
+    keep(`worker ${m.type()}: ${m.text()}`);
+    if (m.type() === "error") problems.push(`worker console: ${m.text()}`);
+  }));
+  logs.set(page, log);
   page.on("request", (req) => { if (!req.url().startsWith(BASE)) stats.outside.push(req.url()); });
   page.on("requestfinished", async (req) => {
     try { const s = await req.sizes(); stats.bytes += s.responseBodySize + s.responseHeadersSize; } catch {}
@@ -73,10 +86,22 @@ async function open(context, url) {
   return { page, problems, stats };
 }
 
-/** Waits until the page shows the motion whose joints hash is `hash` and is idle. */
+/** Waits until the page shows the motion whose joints hash is `hash` and is idle; if it never
+ * does, the error says what the page shows instead and what its console said. */
 async function shows(page, hash) {
-  await page.waitForFunction((h) => document.querySelector(".viewer")?.dataset.jointsHash === h
-    && !document.querySelector("#generate").disabled, hash, { timeout: LOAD_TIMEOUT });
+  try {
+    await page.waitForFunction((h) => document.querySelector(".viewer")?.dataset.jointsHash === h
+      && !document.querySelector("#generate").disabled, hash, { timeout: LOAD_TIMEOUT });
+  } catch (e) {
+    const seen = await page.evaluate(() => ({
+      hash: document.querySelector(".viewer")?.dataset.jointsHash,
+      busy: document.querySelector("#generate")?.disabled,
+      status: document.querySelector("#status")?.textContent,
+      progress: document.querySelector(".status .progress")?.textContent,
+    })).catch((why) => ({ unreadable: String(why) }));
+    throw new Error(`the page never showed joints ${hash}: it shows ${JSON.stringify(seen)}\n`
+      + `console:\n${(logs.get(page) ?? []).slice(-40).join("\n")}\n${e.message}`);
+  }
 }
 
 /** Fills the prompt box: a short walk with `seed`, no review round. */

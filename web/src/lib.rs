@@ -20,6 +20,8 @@ mod browser;
 #[cfg(target_arch = "wasm32")]
 mod client;
 #[cfg(target_arch = "wasm32")]
+mod deadline;
+#[cfg(target_arch = "wasm32")]
 mod llm_fetch;
 #[cfg(target_arch = "wasm32")]
 mod partner;

@@ -9,6 +9,7 @@
 //! JSON they would cost more than they save), built and read only by [`ToPartner`] and
 //! [`FromPartner`].
 
+use crate::deadline::within;
 use coma::model::guidance::{GuidancePartner, PartnerReply, Pass};
 use coma::model::Spam;
 use js_sys::{Array, Float32Array, Function, Int32Array, Object, Promise, Reflect, Uint8Array};
@@ -179,6 +180,12 @@ impl FromPartner {
     }
 }
 
+/// How long a pass may take the partner before the engine runs it itself and stops sending
+/// it passes: a pass takes a fraction of a second, and a partner that crashed without an
+/// error event (out of memory, a trap inside a promise) would otherwise stall generation for
+/// good.
+const REPLY_WAIT_MS: u32 = 10_000;
+
 /// Promises of passes in flight, by id: their resolve and reject functions.
 type Pending = Rc<RefCell<HashMap<u32, (Function, Function)>>>;
 
@@ -328,10 +335,15 @@ impl GuidancePartner for PartnerWorker {
             self.pending.borrow_mut().remove(&id);
             return Box::pin(std::future::ready(Err(format!("{e:?}"))));
         }
+        let (pending, state) = (self.pending.clone(), self.state.clone());
         Box::pin(async move {
-            let values = wasm_bindgen_futures::JsFuture::from(promise)
-                .await
-                .map_err(|e| e.as_string().unwrap_or_else(|| format!("{e:?}")))?;
+            let answer = within(REPLY_WAIT_MS, wasm_bindgen_futures::JsFuture::from(promise));
+            let Some(answer) = answer.await else {
+                let why = format!("no answer to a pass within {} s", REPLY_WAIT_MS / 1000);
+                give_up(&pending, &state, why.clone());
+                return Err(why);
+            };
+            let values = answer.map_err(|e| e.as_string().unwrap_or_else(|| format!("{e:?}")))?;
             Ok(values
                 .dyn_into::<Float32Array>()
                 .map_err(|_| "the partner answered without logits".to_string())?

@@ -4,6 +4,7 @@
 //! progress and outcome back as [`Reply`] JSON; a failed request answers with an error and
 //! leaves the models as they were.
 
+use crate::deadline::within;
 use crate::llm_fetch::FetchTransport;
 use crate::messages::{from_json, to_json, Backend, LlmSettings, Reply, Request};
 use crate::partner::PartnerWorker;
@@ -114,6 +115,11 @@ async fn webgpu_adapter() -> Option<bool> {
     )
 }
 
+/// How long the browser may take to offer a WebGPU adapter, and then to open the device,
+/// before the model goes to the CPU: a GPU answers in about a second, and a GPU process that
+/// is busy (other tabs rendering on a software adapter) or wedged may never answer.
+const WEBGPU_WAIT_MS: u32 = 8_000;
+
 /// The device SPAM runs on: WebGPU where the browser has a hardware adapter (or where it is
 /// asked for), else the CPU backend, with the reason.
 async fn choose_device(asked: Option<Backend>) -> (burn::tensor::Device, Backend, Option<String>) {
@@ -121,19 +127,32 @@ async fn choose_device(asked: Option<Backend>) -> (burn::tensor::Device, Backend
     if asked == Some(Backend::Cpu) {
         return cpu("the page asked for the CPU backend (?backend=cpu)".into());
     }
-    match webgpu_adapter().await {
-        None => cpu("this browser offers no WebGPU adapter, so the model runs on the CPU".into()),
-        Some(true) if asked != Some(Backend::WebGpu) => cpu(
+    let silent = || {
+        format!(
+            "the browser's WebGPU did not answer within {} s, so the model runs on the CPU",
+            WEBGPU_WAIT_MS / 1000
+        )
+    };
+    match within(WEBGPU_WAIT_MS, webgpu_adapter()).await {
+        None => cpu(silent()),
+        Some(None) => {
+            cpu("this browser offers no WebGPU adapter, so the model runs on the CPU".into())
+        }
+        Some(Some(true)) if asked != Some(Backend::WebGpu) => cpu(
             "the browser's only WebGPU adapter is a software one, slower than the CPU backend, \
              so the model runs on the CPU (?backend=webgpu uses it anyway)"
                 .into(),
         ),
-        Some(_) => match burn::tensor::Device::wgpu_options().init_async().await {
-            Ok(device) => (device, Backend::WebGpu, None),
-            Err(e) => cpu(format!(
-                "WebGPU did not start ({e}), so the model runs on the CPU"
-            )),
-        },
+        Some(Some(_)) => {
+            let device = burn::tensor::Device::wgpu_options().init_async();
+            match within(WEBGPU_WAIT_MS, device).await {
+                Some(Ok(device)) => (device, Backend::WebGpu, None),
+                Some(Err(e)) => cpu(format!(
+                    "WebGPU did not start ({e}), so the model runs on the CPU"
+                )),
+                None => cpu(silent()),
+            }
+        }
     }
 }
 
