@@ -1,7 +1,8 @@
 //! Records share links as the page made them before the engine refactor (issue 16): one v2
 //! link of a planned run (plan JSON and run record) and one v1 link of the older format
-//! (segments-only plan), with the joints each must open to. Run once at the commit that
-//! recorded `crate/tests/fixtures/links/`; kept to show how they were made.
+//! (segments-only plan), with the joints each must open to. Run at the commit that recorded
+//! `crate/tests/fixtures/links/`, and again whenever the shipped model changes (a link names
+//! its model): `cargo run --release -p coma --example record_links` from the repository root.
 use coma::agents::llm::{LlmClient, UreqTransport};
 use coma::agents::pipeline::{self, RunOptions};
 use coma::agents::planner::offline;

@@ -1,6 +1,7 @@
 //! Assembling trained runs into a model folder (`coma export`): SPAM's three networks and the
-//! evaluator rounded to f16 (the page's weights), and what that rounding changes in the
-//! motions they reconstruct, the tokens they generate and the scores they give; SPAM with
+//! evaluator rounded to f16 or quantized (the page's weights, see [`crate::weights`]), and
+//! what that changes in the motions they reconstruct, the tokens they generate and the scores
+//! they give; SPAM with
 //! random weights for tests of the plumbing; the training captions' vocabulary for the planner.
 
 use crate::dataset::motions::MotionSet;
@@ -12,10 +13,12 @@ use crate::model::evaluator::{Evaluator, EvaluatorConfig};
 use crate::model::generate::SamplingOptions;
 use crate::model::transformer::PARTS;
 use crate::model::{Spam, SpamConfig, SpamFiles, RESIDUAL_FILE};
+use crate::quant::Bits;
 use crate::text::minilm::SentenceEncoder;
 use crate::train::evaluator::EvaluatorTrainingConfig;
 use crate::train::transformer::TransformerTrainingConfig;
 use crate::train::vq::{reconstruction_errors, VqTrainingConfig};
+use crate::weights::shipped_bytes;
 use anyhow::{Context, Result};
 use burn::config::Config;
 use burn::module::Module;
@@ -23,7 +26,7 @@ use burn::tensor::Device;
 use std::path::{Path, PathBuf};
 
 /// Prompts whose greedily decoded tokens [`ExportedSpam::token_rounding`] compares between the f32
-/// and f16 weights: a walk, a wave and a raise of one hand each, and a bow.
+/// and the shipped weights: a walk, a wave and a raise of one hand each, and a bow.
 pub const ROUNDING_PROMPTS: [&str; 4] = [
     "a person walks forward",
     "a person waves the left hand",
@@ -40,7 +43,7 @@ pub const ROUNDING_VQ_MOTIONS: usize = 200;
 /// Captioned test motions on which [`ExportedEvaluator::rounding`] compares the scores.
 pub const ROUNDING_EVALUATOR_MOTIONS: usize = 224;
 
-/// SPAM written to a model folder in f16, beside the f32 weights of its runs.
+/// SPAM written to a model folder in f16 or quantized, beside the f32 weights of its runs.
 #[derive(Debug)]
 pub struct ExportedSpam {
     /// The model folder written.
@@ -49,15 +52,15 @@ pub struct ExportedSpam {
     pub sizes: SpamConfig,
     /// The runs' weights as trained (f32).
     pub full: Spam,
-    /// The weights as the folder holds them (rounded to f16), loaded back from it.
-    pub half: Spam,
+    /// The weights as the folder holds them (f16 or quantized), loaded back from it.
+    pub shipped: Spam,
     /// Bytes of the folder's weight files (see [`SpamConfig::weight_files`]).
     pub bytes: u64,
     /// The folder's model id (see [`crate::model::model_id`]), which share links name.
     pub id: String,
 }
 
-/// What rounding SPAM to f16 changes in the motions its VQ-VAE reconstructs.
+/// What shipping SPAM in f16 or quantized changes in the motions its VQ-VAE reconstructs.
 #[derive(Clone, Debug)]
 pub struct VqRounding {
     /// Test motions reconstructed.
@@ -66,12 +69,12 @@ pub struct VqRounding {
     pub layers: usize,
     pub vq_layers: usize,
     /// Mean per-joint position error of the reconstructions, root aligned, in millimetres,
-    /// with the f32 and with the f16 weights.
+    /// with the f32 and with the shipped weights.
     pub f32_mm: f64,
-    pub f16_mm: f64,
+    pub shipped_mm: f64,
 }
 
-/// What rounding SPAM to f16 changes in the tokens it generates: of the tokens of
+/// What shipping SPAM in f16 or quantized changes in the tokens it generates: of the tokens of
 /// [`ROUNDING_PROMPTS`], greedily decoded, how many are the same with both weights.
 #[derive(Clone, Copy, Debug)]
 pub struct TokenRounding {
@@ -81,7 +84,7 @@ pub struct TokenRounding {
 
 /// `coma export spam`: the runs' final weights (`vq.bpk`, `base.bpk`, and `residual.bpk`
 /// when `res` names the residual transformer's run; without it the model is base-only)
-/// rounded to f16 into `out` with `spam.json` and the feature statistics of `data`
+/// rounded to f16, and with `bits` quantized, into `out` with `spam.json` and the feature statistics of `data`
 /// (`Mean.npy`, `Std.npy`), then loaded back. [`ExportedSpam::vq_rounding`] and
 /// [`ExportedSpam::token_rounding`] say what the rounding changes.
 pub fn export_spam(
@@ -90,6 +93,7 @@ pub fn export_spam(
     res: Option<&Path>,
     data: &Path,
     out: &Path,
+    bits: Option<Bits>,
 ) -> Result<ExportedSpam> {
     let read = |p: PathBuf| std::fs::read(&p).with_context(|| p.display().to_string());
     let transformer = |run: &Path| {
@@ -124,10 +128,13 @@ pub fn export_spam(
         std::fs::write(out.join(name), bytes).with_context(|| out.join(name).display().to_string())
     };
     write("spam.json", config.as_bytes())?;
-    write("vq.bpk", &crate::weights::f16_bytes(&full.vq)?)?;
-    write("base.bpk", &crate::weights::f16_bytes(&full.base)?)?;
+    write(
+        "vq.bpk",
+        &shipped_bytes(&full.vq, &|name| vq_bits(name, bits), &[])?,
+    )?;
+    write("base.bpk", &shipped_bytes(&full.base, &|_| bits, &[])?)?;
     match &full.residual {
-        Some(r) => write(RESIDUAL_FILE, &crate::weights::f16_bytes(&r.network)?)?,
+        Some(r) => write(RESIDUAL_FILE, &shipped_bytes(&r.network, &|_| bits, &[])?)?,
         // A stale residual file would make the folder fail to load.
         None => match std::fs::remove_file(out.join(RESIDUAL_FILE)) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e)?,
@@ -136,7 +143,7 @@ pub fn export_spam(
     }
     write("mean.npy", &mean)?;
     write("std.npy", &std)?;
-    let (half, _, id) = Spam::load(out, &device)?;
+    let (shipped, _, id) = Spam::load(out, &device)?;
     let bytes: u64 = sizes
         .weight_files()
         .iter()
@@ -146,9 +153,22 @@ pub fn export_spam(
         dir: out.to_path_buf(),
         sizes,
         full,
-        half,
+        shipped,
         bytes,
         id,
+    })
+}
+
+/// Bits of the VQ-VAE's parameter `name` when the model ships at `bits`: its encoders at 4
+/// whatever `bits` says (generation, review and the page only decode; the encoders serve
+/// `coma edit` on an input motion and training), the rest at `bits`.
+fn vq_bits(name: &str, bits: Option<Bits>) -> Option<Bits> {
+    bits.map(|b| {
+        if name.starts_with("encoders.") {
+            Bits::Four
+        } else {
+            b
+        }
     })
 }
 
@@ -156,7 +176,7 @@ impl ExportedSpam {
     /// True when the motions generated from the exported folder get their finer token layers
     /// from a residual transformer; false for a base-only model.
     pub fn has_residual(&self) -> bool {
-        self.half.residual.is_some()
+        self.shipped.residual.is_some()
     }
 
     /// What the rounding changes in reconstructions: the VQ-VAE's error on
@@ -165,17 +185,17 @@ impl ExportedSpam {
     pub fn vq_rounding(&self, data: &Path) -> Result<VqRounding> {
         let device = Device::flex();
         let test = MotionSet::load(data, Split::Test)?;
-        let layers = self.half.generated_layers();
+        let layers = self.shipped.generated_layers();
         let error = |spam: &Spam| {
             reconstruction_errors(&spam.vq, &test, &device, ROUNDING_VQ_MOTIONS, layers)
         };
-        let (e32, e16) = (error(&self.full)?, error(&self.half)?);
+        let (e32, shipped) = (error(&self.full)?, error(&self.shipped)?);
         Ok(VqRounding {
             motions: e32.motions,
             layers,
             vq_layers: self.sizes.vq.layers,
             f32_mm: e32.root_aligned_mm,
-            f16_mm: e16.root_aligned_mm,
+            shipped_mm: shipped.root_aligned_mm,
         })
     }
 
@@ -195,7 +215,7 @@ impl ExportedSpam {
                 temperature: 0.0,
                 ..Default::default()
             };
-            let [a, b] = [&self.full, &self.half]
+            let [a, b] = [&self.full, &self.shipped]
                 .map(|spam| block_on(spam.generate(&condition, ROUNDING_FRAMES, &options)));
             for (x, y) in a
                 .iter()
@@ -211,34 +231,36 @@ impl ExportedSpam {
     }
 }
 
-/// The text–motion evaluator written to a model folder in f16, beside its run's f32 weights.
+/// The text–motion evaluator written to a model folder in f16 or quantized, beside its
+/// run's weights.
 pub struct ExportedEvaluator {
     /// The model folder written.
     pub dir: PathBuf,
     /// The run's weights as trained (f32).
     pub original: Evaluator,
-    /// The weights as the folder holds them (rounded to f16), loaded back from it.
-    pub half: Evaluator,
+    /// The weights as the folder holds them (f16 or quantized), loaded back from it.
+    pub shipped: Evaluator,
     pub config: EvaluatorConfig,
     /// Size of the folder's `evaluator.bpk`.
     pub bytes: usize,
 }
 
-/// What rounding the evaluator to f16 changes, when it could be measured.
+/// What shipping the evaluator in f16 or quantized changes, when it could be measured.
 #[derive(Clone, Debug)]
 pub enum EvaluatorRounding {
     /// The dataset has no test split to measure on.
     NoTestSplit,
     /// The model folder has no sentence encoder to embed the captions.
     NoSentenceEncoder,
-    /// The f32 and f16 evaluators' scores and retrieval on the same captioned test motions.
+    /// The run's and the shipped evaluators' scores and retrieval on the same captioned test
+    /// motions.
     Compared(Agreement),
 }
 
 /// `coma export evaluator`: the run's weights (`evaluator.bpk`, sizes from its
-/// `config.json`) rounded to f16 into `out` as `evaluator.bpk` and `evaluator.json`, then
+/// `config.json`) rounded to f16, and with `bits` quantized, into `out` as `evaluator.bpk` and `evaluator.json`, then
 /// loaded back. [`ExportedEvaluator::rounding`] says what the rounding changes.
-pub fn export_evaluator(run: &Path, out: &Path) -> Result<ExportedEvaluator> {
+pub fn export_evaluator(run: &Path, out: &Path, bits: Option<Bits>) -> Result<ExportedEvaluator> {
     let device = Device::flex();
     let cfg = EvaluatorTrainingConfig::load(run.join("config.json"))
         .map_err(|e| anyhow::anyhow!("{}: {e}", run.join("config.json").display()))?;
@@ -248,13 +270,13 @@ pub fn export_evaluator(run: &Path, out: &Path) -> Result<ExportedEvaluator> {
         .save(out.join("evaluator.json"))
         .map_err(|e| anyhow::anyhow!("writing evaluator.json: {e}"))?;
     let weights = out.join("evaluator.bpk");
-    let bytes = original.to_f16_bytes()?;
+    let bytes = original.to_shipped_bytes(bits)?;
     std::fs::write(&weights, &bytes).with_context(|| weights.display().to_string())?;
-    let (half, config) = Evaluator::load(out, &device)?;
+    let (shipped, config) = Evaluator::load(out, &device)?;
     Ok(ExportedEvaluator {
         dir: out.to_path_buf(),
         original,
-        half,
+        shipped,
         config,
         bytes: bytes.len(),
     })
@@ -291,7 +313,7 @@ impl ExportedEvaluator {
         let sentences: Vec<_> = captions.chunks(64).flat_map(|c| text.encode(c)).collect();
         EvaluatorRounding::Compared(agreement(
             &self.original,
-            &self.half,
+            &self.shipped,
             &self.config,
             &motions,
             &sentences,

@@ -44,6 +44,7 @@ pub mod npy;
 pub mod plan;
 pub mod posecodes;
 pub mod posture;
+pub mod quant;
 pub mod render;
 pub mod rng;
 pub mod session;

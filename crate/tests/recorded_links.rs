@@ -3,6 +3,13 @@
 //! recorded with `crate/examples/record_links.rs` at that time, with the joints each opened
 //! to then (`fixtures/links/*.joints.csv`, 6 decimals).
 //!
+//! A link is exact only for the model that made it (the page offers to regenerate a link of
+//! another model from its prompt), so when the shipped weights change the links are recorded
+//! again with the same example and the new model: in session 14 the weights became quantized
+//! (`crate/src/weights.rs`), and `v1.link`/`v2.link` were recorded again then. What they keep
+//! testing is that both link formats decode, through today's engine, to the joints the engine
+//! gave when they were recorded.
+//!
 //! Since issue 17 the engine puts every motion on the one reference skeleton
 //! ([`coma::skeleton::fixed_bones`]: bones keep their directions and get the reference
 //! lengths). The recordings are kept as they were made, with the model's stretched bones, and

@@ -40,9 +40,10 @@ fn tokenizer_matches_the_reference_ids() {
 
 // ---- the sentence encoder (`coma::text::minilm`) ----
 
+use coma::quant::Bits;
 use coma::text::minilm::{
     convert_minilm, MiniLm, MiniLmError, SentenceEncoder, WordEmbeddings, WordsFormatError,
-    EMBEDDING_DIM, MODEL_FILE, WORDS_FILE,
+    EMBEDDING_DIM, MODEL_FILE, SHIPPED_ENCODER_BITS, SHIPPED_WORD_BITS, WORDS_FILE,
 };
 use std::sync::OnceLock;
 
@@ -109,7 +110,9 @@ fn minilm_embeddings_match_the_reference() {
         if c < min.0 {
             min = (c, s["text"].as_str().unwrap());
         }
-        assert!(c >= 0.999, "cosine {c} for {:?}", s["text"]);
+        // The shipped 4-bit word table costs up to three thousandths (at 8 bits the lowest is
+        // 0.9996); EVAL.md's figures hold with it (MODEL_CARD.md).
+        assert!(c >= 0.997, "cosine {c} for {:?}", s["text"]);
     }
     println!(
         "cosine with the reference over {} sentences: min {:.6} ({:?}), mean {:.6}",
@@ -214,10 +217,16 @@ fn minilm_rejects_corrupt_bytes() {
         Err(WordsFormatError::Length { .. })
     ));
     let mut bad = words.clone();
-    bad[16..20].copy_from_slice(&f32::NAN.to_le_bytes());
+    bad[16..20].copy_from_slice(&5u32.to_le_bytes());
     assert_eq!(
         WordEmbeddings::from_bytes(&bad),
-        Err(WordsFormatError::BadScale(0))
+        Err(WordsFormatError::Bits(5))
+    );
+    let mut bad = words.clone();
+    bad[20..22].copy_from_slice(&burn::tensor::f16::NAN.to_le_bytes());
+    assert_eq!(
+        WordEmbeddings::from_bytes(&bad),
+        Err(WordsFormatError::BadScale)
     );
 
     // Encoder weights: empty, garbage, truncated.
@@ -250,7 +259,7 @@ fn minilm_rejects_corrupt_bytes() {
         load(&vocab, &words[..20], &model),
         Err(MiniLmError::Words(_))
     ));
-    let small = WordEmbeddings::quantize(&[0.5; 4 * EMBEDDING_DIM], 4, EMBEDDING_DIM);
+    let small = WordEmbeddings::quantize(&[0.5; 4 * EMBEDDING_DIM], 4, EMBEDDING_DIM, Bits::Four);
     assert!(matches!(
         load(&vocab, &small.to_bytes(), &model),
         Err(MiniLmError::Mismatch(_))
@@ -267,42 +276,48 @@ fn minilm_rejects_corrupt_bytes() {
 
 #[test]
 fn minilm_word_table_round_trips() {
-    let (rows, cols) = (5, 7);
-    let table: Vec<f32> = (0..rows * cols)
+    let (rows, cols) = (5, 64);
+    let mut table: Vec<f32> = (0..rows * cols)
         .map(|i| ((i as f32) * 0.37).sin() * (1.0 + i as f32 / 10.0))
-        .map(|v| if v.abs() < 0.05 { 0.0 } else { v })
         .collect();
-    let mut table = table;
     table[2 * cols..3 * cols].fill(0.0); // an all-zero row keeps scale 0
-    let q = WordEmbeddings::quantize(&table, rows, cols);
-    assert_eq!((q.rows(), q.cols()), (rows, cols));
-    let bytes = q.to_bytes();
-    assert_eq!(bytes.len(), 16 + 4 * rows + rows * cols);
-    assert_eq!(&bytes[..4], &WordEmbeddings::MAGIC);
-    let back = WordEmbeddings::from_bytes(&bytes).unwrap();
-    assert_eq!(back, q);
-    assert_eq!(back.to_bytes(), bytes);
+    for bits in [Bits::Four, Bits::Eight] {
+        let q = WordEmbeddings::quantize(&table, rows, cols, bits);
+        assert_eq!((q.rows(), q.cols()), (rows, cols));
+        let bytes = q.to_bytes();
+        let values = rows * cols;
+        assert_eq!(
+            bytes.len(),
+            20 + 2 * bits.blocks(values) + bits.packed_len(values)
+        );
+        assert_eq!(&bytes[..4], &WordEmbeddings::MAGIC);
+        let back = WordEmbeddings::from_bytes(&bytes).unwrap();
+        assert_eq!(back, q);
+        assert_eq!(back.to_bytes(), bytes);
 
-    let ids: Vec<u32> = vec![4, 0, 2, 2, 1, 3];
-    let looked_up = back.lookup(&ids);
-    assert_eq!(looked_up.len(), ids.len() * cols);
-    for (k, &id) in ids.iter().enumerate() {
-        let row = &table[id as usize * cols..(id as usize + 1) * cols];
-        let max = row.iter().fold(0f32, |m, v| m.max(v.abs()));
-        for (got, want) in looked_up[k * cols..(k + 1) * cols].iter().zip(row) {
-            // Rounding to the nearest step: at most half a step of max/127.
-            assert!(
-                (got - want).abs() <= max / 127.0 / 2.0 + 1e-7,
-                "row {id}: {got} vs {want}"
-            );
+        let ids: Vec<u32> = vec![4, 0, 2, 2, 1, 3];
+        let looked_up = back.lookup(&ids);
+        assert_eq!(looked_up.len(), ids.len() * cols);
+        let max_q = if bits == Bits::Four { 7.0 } else { 127.0 };
+        for (k, &id) in ids.iter().enumerate() {
+            for c in 0..cols {
+                // Rounding to the nearest step: at most half a step of the block's max/qmax
+                // (its f16 scale rounded up by at most one part in 1024). Blocks run through
+                // the table row-major, so one may span rows.
+                let i = id as usize * cols + c;
+                let block = &table[i / bits.block() * bits.block()..][..bits
+                    .block()
+                    .min(table.len() - i / bits.block() * bits.block())];
+                let max = block.iter().fold(0f32, |m, v| m.max(v.abs()));
+                let (got, want) = (looked_up[k * cols + c], table[i]);
+                assert!(
+                    (got - want).abs() <= max / max_q / 2.0 * 1.001 + 1e-7,
+                    "{bits:?} row {id} column {c}: {got} vs {want}"
+                );
+            }
         }
-        // The largest value of a row is exact (±127 steps).
-        if max > 0.0 {
-            let i = row.iter().position(|v| v.abs() == max).unwrap();
-            assert!((looked_up[k * cols + i].abs() - max).abs() < 1e-6);
-        }
+        assert!(looked_up[3 * cols..4 * cols].iter().all(|&v| v == 0.0));
     }
-    assert!(looked_up[3 * cols..4 * cols].iter().all(|&v| v == 0.0));
 }
 
 #[test]
@@ -339,7 +354,13 @@ fn minilm_conversion_reproduces_the_committed_files() {
         return;
     };
     let out = tempfile::tempdir().unwrap();
-    let report = convert_minilm(&checkpoint, out.path()).unwrap();
+    let report = convert_minilm(
+        &checkpoint,
+        out.path(),
+        SHIPPED_WORD_BITS,
+        SHIPPED_ENCODER_BITS,
+    )
+    .unwrap();
     println!("{report:?}");
     for (name, size) in [
         (WORDS_FILE, report.words_bytes),
@@ -358,6 +379,12 @@ fn minilm_conversion_reproduces_the_committed_files() {
 #[ignore = "writes static/models; run explicitly after changing the conversion"]
 fn convert_minilm_into_static_models() {
     let checkpoint = original_checkpoint().expect("the original checkpoint is not installed");
-    let report = convert_minilm(&checkpoint, &models_dir()).unwrap();
+    let report = convert_minilm(
+        &checkpoint,
+        &models_dir(),
+        SHIPPED_WORD_BITS,
+        SHIPPED_ENCODER_BITS,
+    )
+    .unwrap();
     println!("{report:#?}");
 }

@@ -1,23 +1,40 @@
 //! `coma-serve [DIR] [--port N]`: the built page on localhost, without building the engine
 //! (what `scripts/start.sh` runs; `coma serve` does the same from the full CLI).
+//! `coma-serve --compress DIR` writes the brotli copies the build leaves beside the page's
+//! files (`scripts/tools.sh`).
 
 fn main() {
     let mut args = std::env::args().skip(1);
     let mut dir = std::path::PathBuf::from("dist");
     let mut port = 8080u16;
+    let mut compress = false;
     while let Some(arg) = args.next() {
         match arg.as_str() {
+            "--compress" => compress = true,
             "--port" => match args.next().and_then(|p| p.parse().ok()) {
                 Some(p) => port = p,
                 None => fail("--port needs a port number (1-65535)"),
             },
             "-h" | "--help" => {
                 println!("usage: coma-serve [DIR (default dist)] [--port N (default 8080)]");
+                println!("       coma-serve --compress DIR   (writes brotli copies of its files)");
                 return;
             }
             other if other.starts_with('-') => fail(&format!("unknown option {other}")),
             other => dir = other.into(),
         }
+    }
+    if compress {
+        match coma_serve::compress_dir(&dir, coma_serve::COMPRESSED) {
+            Ok((before, after)) => println!(
+                "brotli copies in {}: {:.1} MB as {:.1} MB",
+                dir.display(),
+                before as f64 / 1e6,
+                after as f64 / 1e6
+            ),
+            Err(e) => fail(&format!("{e:#}")),
+        }
+        return;
     }
     if let Err(e) = coma_serve::serve_page(&dir, port) {
         fail(&format!("{e:#}"));

@@ -1,4 +1,4 @@
-//! How far two evaluators (f32 weights and their f16 rounding, say) disagree on the same
+//! How far two evaluators (f32 weights and their shipped f16 or quantized copy, say) disagree on the same
 //! motions and captions: `coma export evaluator` prints it before the page gets the rounding.
 
 use super::metrics::r_precision;
@@ -7,7 +7,7 @@ use crate::model::evaluator::{alignment_score, Evaluator, EvaluatorConfig};
 use crate::model::transformer::TEXT_DIM;
 use burn::prelude::*;
 
-/// How far two evaluators (f32 weights and their f16 rounding, say) disagree on the same
+/// How far two evaluators (f32 weights and their shipped f16 or quantized copy, say) disagree on the same
 /// motions and captions (see [`agreement`]).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Agreement {
@@ -83,7 +83,7 @@ mod tests {
         let device = Device::flex();
         let cfg = tiny();
         let full = cfg.init(&device);
-        let f16_bytes = full.to_f16_bytes().unwrap();
+        let f16_bytes = full.to_shipped_bytes(None).unwrap();
         let text = serde_json::to_string(&cfg).unwrap();
         let (half, _) = Evaluator::from_bytes(&text, &f16_bytes, &device).unwrap();
         let motions: Vec<Vec<FeatureFrame>> = (0..64)

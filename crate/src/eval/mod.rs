@@ -1,5 +1,5 @@
 //! Measuring the model: the field's metrics computed with the text–motion evaluator
-//! ([`crate::model::evaluator`]), how far its f16 rounding moves them, the
+//! ([`crate::model::evaluator`]), how far its shipped precision moves them, the
 //! evaluation protocol and its report, control probes, and the agents' figures.
 
 // Runs the agents' loop to completion on this thread: native only.

@@ -17,10 +17,10 @@
 //! Euclidean distances of the field's metrics lie in [0, 2].
 //!
 //! Weights (`evaluator.bpk`, with its sizes in `evaluator.json`): training saves f32 (a burn
-//! `ModuleRecord`, a burnpack); `coma export evaluator` rounds every float parameter to f16
-//! ([`Evaluator::to_f16_bytes`]), halving the page's download (2.0 M parameters, 4 MB), and
-//! reports what that changes on the test split (`eval::agreement`). Loading takes either and
-//! computes in f32: f16 values are widened on load.
+//! `ModuleRecord`, a burnpack); `coma export evaluator` rounds every float parameter to f16,
+//! or with `--bits` quantizes the matrices ([`Evaluator::to_shipped_bytes`]; the shipped file
+//! is 8-bit, 2.0 MB for 2.0 M parameters), and reports what that changes on the test split
+//! (`eval::agreement`). Loading takes any of them and computes in f32.
 
 use crate::features::{FeatureFrame, FEATURE_DIM};
 use crate::model::transformer::TEXT_DIM;
@@ -257,7 +257,7 @@ pub struct EvaluatorLoadError {
 
 impl Evaluator {
     /// The evaluator from the contents of `evaluator.json` and `evaluator.bpk` (no file
-    /// system, so it works in the page). The weights may be f32 or f16; f16 ones are widened
+    /// system, so it works in the page). The weights may be f32, f16 or quantized; all are widened
     /// to f32.
     pub fn from_bytes(
         config: &str,
@@ -291,7 +291,8 @@ impl Evaluator {
     }
 
     /// Loads weights of the sizes `config` from a burnpack file (f32 as training saves them,
-    /// or f16 as [`Self::to_f16_bytes`] writes them; computing is f32 either way).
+    /// or f16 or quantized as [`Self::to_shipped_bytes`] writes them; computing is f32 either
+    /// way).
     pub fn load_weights(
         config: &EvaluatorConfig,
         weights: &std::path::Path,
@@ -301,20 +302,16 @@ impl Evaluator {
             file: weights.display().to_string(),
             message,
         };
-        let record =
-            burn::store::ModuleRecord::load(weights).map_err(|e| error(format!("{e:?}")))?;
-        config
-            .init(device)
-            .try_load_record(record.cast_to_module_dtype())
-            .map_err(|e| error(format!("{e:?}")))
+        let bytes = std::fs::read(weights).map_err(|e| error(e.to_string()))?;
+        crate::weights::load_into(config.init(device), &bytes).map_err(error)
     }
 
-    /// `evaluator.bpk` with every float parameter rounded to f16 (half the bytes): a burnpack
-    /// of the same tensor names and shapes as training's f32 file, without parameter ids, so
-    /// the same weights always give the same bytes. [`Self::from_bytes`] and [`Self::load`]
-    /// read it back as f32.
-    pub fn to_f16_bytes(&self) -> anyhow::Result<Vec<u8>> {
-        crate::weights::f16_bytes(self)
+    /// `evaluator.bpk` for shipping: every float rounded to f16, and with `bits` the large
+    /// tensors quantized (see [`crate::weights`]); without parameter ids, so the same weights
+    /// always give the same bytes. [`Self::from_bytes`] and [`Self::load`] read it back as
+    /// f32.
+    pub fn to_shipped_bytes(&self, bits: Option<crate::quant::Bits>) -> anyhow::Result<Vec<u8>> {
+        crate::weights::shipped_bytes(self, &|_| bits, &[])
     }
 }
 
@@ -416,7 +413,7 @@ pub(crate) mod tests {
         let cfg = tiny();
         let full = cfg.init(&device);
         let f32_bytes = full.clone().into_record().into_bytes().unwrap().to_vec();
-        let f16_bytes = full.to_f16_bytes().unwrap();
+        let f16_bytes = full.to_shipped_bytes(None).unwrap();
         assert!(
             f16_bytes.len() * 10 < f32_bytes.len() * 6,
             "{} bytes in f16, {} in f32",
@@ -424,7 +421,7 @@ pub(crate) mod tests {
             f32_bytes.len()
         );
         // The same weights give the same bytes (no parameter ids).
-        assert_eq!(f16_bytes, full.to_f16_bytes().unwrap());
+        assert_eq!(f16_bytes, full.to_shipped_bytes(None).unwrap());
 
         let text = serde_json::to_string(&cfg).unwrap();
         let (half, _) = Evaluator::from_bytes(&text, &f16_bytes, &device).unwrap();

@@ -20,14 +20,15 @@
 //! 20 reference sentences).
 
 use super::tokenizer::{Tokenizer, VocabError};
+use crate::quant::{Bits, Blocks};
 use burn::module::Module;
 use burn::nn::attention::{MhaInput, MultiHeadAttention, MultiHeadAttentionConfig};
 use burn::nn::{Embedding, EmbeddingConfig, LayerNorm, LayerNormConfig, Linear, LinearConfig};
 use burn::prelude::*;
-use burn::store::burn_pack::{Reader as PackReader, Tensor as PackTensor, Writer as PackWriter};
+use burn::store::burn_pack::Tensor as PackTensor;
 use burn::store::{bridge, KeyRemapper, ModuleSnapshot, PyTorchToBurnAdapter, SafetensorsStore};
 use burn::tensor::activation::gelu;
-use burn::tensor::{Bytes, DType};
+use burn::tensor::{f16, DType};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -38,6 +39,15 @@ pub const EMBEDDING_DIM: usize = 384;
 pub const VOCAB_FILE: &str = "minilm-vocab.txt";
 /// The int8 word-embedding table (see [`WordEmbeddings`]) written by [`convert_minilm`].
 pub const WORDS_FILE: &str = "minilm-words.i8";
+
+/// Bits per value of the shipped word table (`static/models`): 4 bits halve its download,
+/// and sentence embeddings stay within 0.997 cosine of the reference (`crate/tests/text.rs`;
+/// 0.9996 at 8 bits), which `EVAL.md`'s figures bear.
+pub const SHIPPED_WORD_BITS: Bits = Bits::Four;
+
+/// Bits per value of the shipped encoder's matrices: at 4 bits a sentence's embedding drifts
+/// to 0.97 cosine of the reference ("a person walks forward"), too far to keep.
+pub const SHIPPED_ENCODER_BITS: Bits = Bits::Eight;
 /// The burnpack of the rest of the encoder ([`MiniLm`], int8 Linear weights) written by
 /// [`convert_minilm`].
 pub const MODEL_FILE: &str = "minilm-encoder.bpk";
@@ -188,38 +198,46 @@ impl MiniLm {
         x
     }
 
-    /// Value of the `format` metadata of [`MODEL_FILE`] (the table above).
-    pub const FORMAT: &'static str = "coma-minilm-encoder/1";
-    /// Name suffix of the scales of an int8 matrix.
+    /// Value of the `format` metadata of [`MODEL_FILE`] that [`Self::to_bytes`] writes:
+    /// [`crate::weights`]' layout (floats in f16, matrices and embeddings quantized in blocks).
+    pub const FORMAT: &'static str = "coma-minilm-encoder/2";
+    /// The earlier format (the table above), still read.
+    pub const FORMAT_COLUMNS: &'static str = "coma-minilm-encoder/1";
+    /// Name suffix of the scales of an int8 matrix in [`Self::FORMAT_COLUMNS`].
     const SCALE_SUFFIX: &'static str = "_scale";
 
-    /// Whether the parameter `name` of this module is stored as int8: the Linear weights of
-    /// the encoder layers (every `.weight` under `layers.`; the LayerNorms' are `gamma`).
-    fn stored_as_int8(name: &str) -> bool {
-        name.starts_with("layers.") && name.ends_with(".weight")
-    }
-
-    /// Loads an encoder from the bytes of [`MODEL_FILE`] (the format above), widening int8
-    /// and f16 tensors to f32. Damaged bytes give an error, not a panic (checked for empty,
-    /// garbage and truncated input, and for files of another format).
+    /// Loads an encoder from the bytes of [`MODEL_FILE`] (either format), widening every
+    /// tensor to f32. Damaged bytes give an error, not a panic (checked for empty, garbage
+    /// and truncated input, and for files of another format).
     pub fn from_bytes(bytes: &[u8], device: &Device) -> Result<MiniLm, MiniLmError> {
         let error = |message: String| MiniLmError::Model(message);
-        let pack = |e: burn::store::burn_pack::Error| MiniLmError::Model(e.to_string());
-        let reader = PackReader::from_bytes(Bytes::from_bytes_vec(bytes.to_vec())).map_err(pack)?;
-        let format = reader.metadata().get("format").map(String::as_str);
-        if format != Some(Self::FORMAT) {
-            return Err(error(format!(
-                "format {format:?}, expected {:?} (an older minilm.bpk? convert again with \
-                 `coma text convert`)",
-                Self::FORMAT
-            )));
+        let (tensors, metadata) = crate::weights::read_widened(bytes).map_err(error)?;
+        let tensors = match metadata.get("format").map(String::as_str) {
+            Some(Self::FORMAT) => tensors,
+            Some(Self::FORMAT_COLUMNS) => Self::widen_columns(tensors)?,
+            format => {
+                return Err(error(format!(
+                    "format {format:?}, expected {:?} (an older minilm.bpk? convert again with \
+                     `coma text convert`)",
+                    Self::FORMAT
+                )))
+            }
+        };
+        let mut model = MiniLmConfig::new().init(device);
+        let result = model.apply(tensors, None, None, false);
+        if !(result.errors.is_empty() && result.missing.is_empty() && result.unused.is_empty()) {
+            return Err(error(result.to_string()));
         }
-        let mut tensors: BTreeMap<String, PackTensor> = reader
-            .into_tensors()
-            .map_err(pack)?
-            .into_iter()
-            .map(|t| (t.name.clone(), t))
-            .collect();
+        Ok(model)
+    }
+
+    /// The tensors of a [`Self::FORMAT_COLUMNS`] file with its int8 matrices widened by their
+    /// column scales.
+    fn widen_columns(tensors: Vec<PackTensor>) -> Result<Vec<PackTensor>, MiniLmError> {
+        let error = |message: String| MiniLmError::Model(message);
+        let pack = |e: burn::store::burn_pack::Error| MiniLmError::Model(e.to_string());
+        let mut tensors: BTreeMap<String, PackTensor> =
+            tensors.into_iter().map(|t| (t.name.clone(), t)).collect();
         let scale_names: Vec<String> = tensors
             .keys()
             .filter(|name| name.ends_with(Self::SCALE_SUFFIX))
@@ -231,22 +249,19 @@ impl MiniLm {
             .collect();
         let mut widened = Vec::with_capacity(tensors.len());
         for (name, tensor) in tensors {
+            if tensor.dtype != DType::I8 {
+                widened.push(tensor);
+                continue;
+            }
             let data = bridge::into_data(tensor).map_err(pack)?;
             let shape = data.shape().to_vec();
-            let values: Vec<f32> = match data.dtype() {
-                DType::I8 => {
-                    let scale_name = format!("{name}{}", Self::SCALE_SUFFIX);
-                    let scale = scales
-                        .remove(&scale_name)
-                        .ok_or_else(|| error(format!("{name}: int8 without {scale_name}")))?;
-                    let scale = bridge::into_data(scale).map_err(pack)?;
-                    dequantize_columns(&data, &scale).map_err(|m| error(format!("{name}: {m}")))?
-                }
-                DType::F16 | DType::F32 => data
-                    .try_into_vec_as::<f32>()
-                    .map_err(|e| error(format!("{name}: {e:?}")))?,
-                other => return Err(error(format!("{name}: unexpected dtype {other:?}"))),
-            };
+            let scale_name = format!("{name}{}", Self::SCALE_SUFFIX);
+            let scale = scales
+                .remove(&scale_name)
+                .ok_or_else(|| error(format!("{name}: int8 without {scale_name}")))?;
+            let scale = bridge::into_data(scale).map_err(pack)?;
+            let values =
+                dequantize_columns(&data, &scale).map_err(|m| error(format!("{name}: {m}")))?;
             widened.push(bridge::from_data(
                 TensorData::new(values, shape),
                 name,
@@ -256,85 +271,27 @@ impl MiniLm {
         if let Some(name) = scales.keys().next() {
             return Err(error(format!("{name} scales no int8 matrix")));
         }
-        let mut model = MiniLmConfig::new().init(device);
-        let result = model.apply(widened, None, None, false);
-        if !(result.errors.is_empty() && result.missing.is_empty() && result.unused.is_empty()) {
-            return Err(error(result.to_string()));
-        }
-        Ok(model)
+        Ok(widened)
     }
 
-    /// The bytes of [`MODEL_FILE`] (the format above) for this encoder: the Linear weights of
-    /// the layers quantised to int8 with a scale per output, everything else rounded to f16.
-    /// The bytes depend on the weights only, so a conversion always gives the same file.
-    pub fn to_bytes(&self) -> Result<Vec<u8>, MiniLmError> {
-        let pack = |e: burn::store::burn_pack::Error| MiniLmError::Model(e.to_string());
-        let mut tensors = Vec::new();
-        for tensor in self.collect(None, None, false) {
-            let name = tensor.name.clone();
-            let data = bridge::into_data(tensor).map_err(pack)?;
-            if Self::stored_as_int8(&name) && data.rank() == 2 {
-                let (values, scales) = quantize_columns(&data)
-                    .map_err(|m| MiniLmError::Model(format!("{name}: {m}")))?;
-                let scale_name = format!("{name}{}", Self::SCALE_SUFFIX);
-                tensors.push(bridge::from_data(scales, scale_name, None));
-                tensors.push(bridge::from_data(values, name, None));
-            } else {
-                // No parameter ids: they are random per process and only matter to resume
-                // training.
-                tensors.push(bridge::from_data(
-                    data.convert_dtype(DType::F16),
-                    name,
-                    None,
-                ));
-            }
-        }
-        let bytes = PackWriter::new(tensors)
-            .with_metadata("format", Self::FORMAT)
-            .with_metadata("model", "all-MiniLM-L6-v2 without word embeddings")
-            .into_bytes()
-            .map_err(pack)?;
-        Ok(bytes.to_vec())
+    /// The bytes of [`MODEL_FILE`] for this encoder in [`Self::FORMAT`], its matrices and
+    /// embeddings quantized to `bits`. The bytes depend on the weights only, so a conversion
+    /// always gives the same file.
+    pub fn to_bytes(&self, bits: Bits) -> Result<Vec<u8>, MiniLmError> {
+        crate::weights::shipped_bytes(
+            self,
+            &|_| Some(bits),
+            &[
+                ("format", Self::FORMAT),
+                ("model", "all-MiniLM-L6-v2 without word embeddings"),
+            ],
+        )
+        .map_err(|e| MiniLmError::Model(e.to_string()))
     }
 }
 
-/// A `[rows, cols]` f32 matrix as int8 `[rows, cols]` and f32 `[cols]` scales, symmetric per
-/// column: `scale[c] = max_r |m[r, c]| / 127`, `q = round(m / scale)`. Columns are the outputs
-/// of a burn Linear weight.
-fn quantize_columns(matrix: &TensorData) -> Result<(TensorData, TensorData), String> {
-    let [rows, cols] = matrix.shape().dims::<2>();
-    let m: Vec<f32> = matrix
-        .clone()
-        .try_into_vec_as::<f32>()
-        .map_err(|e| format!("{e:?}"))?;
-    let mut max = vec![0f32; cols];
-    for row in m.chunks_exact(cols) {
-        for (mx, v) in max.iter_mut().zip(row) {
-            *mx = mx.max(v.abs());
-        }
-    }
-    let scales: Vec<f32> = max.iter().map(|m| m / 127.0).collect();
-    // An all-zero column keeps scale 0; dividing by it would give NaN.
-    let inv: Vec<f32> = scales
-        .iter()
-        .map(|&s| if s > 0.0 { 1.0 / s } else { 0.0 })
-        .collect();
-    let q: Vec<i8> = m
-        .chunks_exact(cols)
-        .flat_map(|row| {
-            row.iter()
-                .zip(&inv)
-                .map(|(v, i)| (v * i).round().clamp(-127.0, 127.0) as i8)
-        })
-        .collect();
-    Ok((
-        TensorData::new(q, [rows, cols]),
-        TensorData::new(scales, [cols]),
-    ))
-}
-
-/// The f32 values of an int8 `[rows, cols]` matrix with `[cols]` scales (the inverse of
-/// [`quantize_columns`]), checking the shapes and that every scale is finite and ≥ 0.
+/// The f32 values of an int8 `[rows, cols]` matrix with `[cols]` scales (each column `c` is
+/// `q[r, c] · scale[c]`), checking the shapes and that every scale is finite and ≥ 0.
 fn dequantize_columns(values: &TensorData, scales: &TensorData) -> Result<Vec<f32>, String> {
     let shape = values.shape().to_vec();
     let &[_, cols] = shape.as_slice() else {
@@ -399,63 +356,53 @@ pub enum WordsFormatError {
         /// Byte count given.
         found: u64,
     },
-    /// A row scale is negative, infinite or NaN.
-    #[error("row {0} has an invalid scale")]
-    BadScale(usize),
+    /// A scale is negative, infinite or NaN.
+    #[error("a scale is negative, infinite or NaN")]
+    BadScale,
+    /// Bits per value other than 4 or 8.
+    #[error("{0} bits per value; 4 or 8 are read")]
+    Bits(u32),
 }
 
-/// A word-embedding table quantised to int8 with one f32 scale per row (symmetric:
-/// `scale = max|row| / 127`, `value ≈ q * scale`), looked up on the CPU.
+/// The word-embedding table, quantized ([`Blocks`]) and looked up on the CPU row by row.
 ///
 /// File format (`minilm-words.i8`), little endian, no padding:
 ///
 /// | offset | size | content |
 /// |---|---|---|
 /// | 0 | 4 | magic `b"CMWE"` ([`Self::MAGIC`]) |
-/// | 4 | 4 | `u32` version, 1 |
+/// | 4 | 4 | `u32` version: 2 (1, the earlier per-row int8, is still read) |
 /// | 8 | 4 | `u32` rows |
 /// | 12 | 4 | `u32` cols |
-/// | 16 | 4 × rows | `f32` scale of each row |
-/// | 16 + 4 × rows | rows × cols | `i8` values, row-major |
+/// | 16 | 4 | `u32` bits per value, 4 or 8 |
+/// | 20 | 2 × blocks | `f16` scale of each block ([`Bits::block`] values) |
+/// | then | the rest | the packed values, row-major, as [`Bits`] says |
+///
+/// Version 1: `rows`, `cols`, then an `f32` scale per row and `rows × cols` `i8` values; it
+/// is read by re-quantizing it to 8-bit blocks.
 #[derive(Clone, PartialEq)]
 pub struct WordEmbeddings {
     rows: usize,
     cols: usize,
-    scales: Vec<f32>,
-    values: Vec<i8>,
+    blocks: Blocks,
 }
 
 impl WordEmbeddings {
     /// First bytes of the file ("CoMA word embeddings").
     pub const MAGIC: [u8; 4] = *b"CMWE";
     /// Format version written by [`Self::to_bytes`].
-    pub const VERSION: u32 = 1;
-    const HEADER: usize = 16;
+    pub const VERSION: u32 = 2;
 
-    /// Quantises a row-major `rows × cols` f32 table.
+    /// Quantizes a row-major `rows × cols` f32 table to `bits`.
     ///
     /// # Panics
-    /// If `table.len() != rows * cols`.
-    pub fn quantize(table: &[f32], rows: usize, cols: usize) -> WordEmbeddings {
+    /// If `table.len() != rows * cols` or a value is not finite.
+    pub fn quantize(table: &[f32], rows: usize, cols: usize, bits: Bits) -> WordEmbeddings {
         assert_eq!(table.len(), rows * cols, "table is not rows × cols");
-        let mut scales = Vec::with_capacity(rows);
-        let mut values = Vec::with_capacity(rows * cols);
-        for row in (0..rows).map(|r| &table[r * cols..(r + 1) * cols]) {
-            let max = row.iter().fold(0f32, |m, v| m.max(v.abs()));
-            let scale = max / 127.0;
-            scales.push(scale);
-            // An all-zero row keeps scale 0; dividing by it would give NaN.
-            let inv = if scale > 0.0 { 1.0 / scale } else { 0.0 };
-            values.extend(
-                row.iter()
-                    .map(|v| (v * inv).round().clamp(-127.0, 127.0) as i8),
-            );
-        }
         WordEmbeddings {
             rows,
             cols,
-            scales,
-            values,
+            blocks: Blocks::quantize(table, bits).expect("a finite word table"),
         }
     }
 
@@ -465,53 +412,97 @@ impl WordEmbeddings {
             expected,
             found: bytes.len() as u64,
         };
-        if bytes.len() < Self::HEADER {
-            return Err(length_error(Self::HEADER as u64));
+        if bytes.len() < 16 {
+            return Err(length_error(16));
         }
         if bytes[0..4] != Self::MAGIC {
             return Err(WordsFormatError::BadMagic);
         }
         let word = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
-        let version = word(4);
-        if version != Self::VERSION {
-            return Err(WordsFormatError::Version(version));
-        }
+        // u64 so that a corrupt header cannot overflow the size computations.
         let (rows, cols) = (word(8) as u64, word(12) as u64);
-        // u64 so that a corrupt header cannot overflow the size computation.
-        let expected = Self::HEADER as u64 + 4 * rows + rows * cols;
+        match word(4) {
+            1 => Self::from_rows(bytes, rows, cols),
+            2 => {
+                if bytes.len() < 20 {
+                    return Err(length_error(20));
+                }
+                let bits = match word(16) {
+                    4 => Bits::Four,
+                    8 => Bits::Eight,
+                    other => return Err(WordsFormatError::Bits(other)),
+                };
+                let len = rows * cols;
+                let scales_end = 20 + 2 * len.div_ceil(bits.block() as u64);
+                let expected = scales_end + bits.packed_len(len as usize) as u64;
+                if bytes.len() as u64 != expected {
+                    return Err(length_error(expected));
+                }
+                let scales = bytes[20..scales_end as usize]
+                    .chunks_exact(2)
+                    .map(|b| f16::from_le_bytes([b[0], b[1]]))
+                    .collect();
+                let packed = bytes[scales_end as usize..].to_vec();
+                let blocks = Blocks::from_parts(bits, len as usize, scales, packed)
+                    .map_err(|_| WordsFormatError::BadScale)?;
+                Ok(WordEmbeddings {
+                    rows: rows as usize,
+                    cols: cols as usize,
+                    blocks,
+                })
+            }
+            version => Err(WordsFormatError::Version(version)),
+        }
+    }
+
+    /// Version 1 (per-row int8), re-quantized to 8-bit blocks.
+    fn from_rows(bytes: &[u8], rows: u64, cols: u64) -> Result<WordEmbeddings, WordsFormatError> {
+        let expected = 16 + 4 * rows + rows * cols;
         if bytes.len() as u64 != expected {
-            return Err(length_error(expected));
+            return Err(WordsFormatError::Length {
+                expected,
+                found: bytes.len() as u64,
+            });
         }
         let (rows, cols) = (rows as usize, cols as usize);
-        let scales_end = Self::HEADER + 4 * rows;
-        let scales: Vec<f32> = bytes[Self::HEADER..scales_end]
+        let scales_end = 16 + 4 * rows;
+        let scales: Vec<f32> = bytes[16..scales_end]
             .chunks_exact(4)
             .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
             .collect();
-        if let Some(bad) = scales.iter().position(|s| !s.is_finite() || *s < 0.0) {
-            return Err(WordsFormatError::BadScale(bad));
+        if scales.iter().any(|s| !s.is_finite() || *s < 0.0) {
+            return Err(WordsFormatError::BadScale);
         }
-        let values = bytes[scales_end..].iter().map(|&b| b as i8).collect();
-        Ok(WordEmbeddings {
-            rows,
-            cols,
-            scales,
-            values,
-        })
+        let table: Vec<f32> = bytes[scales_end..]
+            .chunks_exact(cols.max(1))
+            .zip(&scales)
+            .flat_map(|(row, s)| row.iter().map(move |&q| q as i8 as f32 * s))
+            .collect();
+        Ok(Self::quantize(&table, rows, cols, Bits::Eight))
     }
 
     /// The file format above.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(Self::HEADER + 4 * self.rows + self.values.len());
+        let bits: u32 = match self.blocks.bits() {
+            Bits::Four => 4,
+            Bits::Eight => 8,
+        };
+        let mut out =
+            Vec::with_capacity(20 + 2 * self.blocks.scales().len() + self.blocks.packed().len());
         out.extend_from_slice(&Self::MAGIC);
-        out.extend_from_slice(&Self::VERSION.to_le_bytes());
-        out.extend_from_slice(&(self.rows as u32).to_le_bytes());
-        out.extend_from_slice(&(self.cols as u32).to_le_bytes());
-        for s in &self.scales {
+        for word in [Self::VERSION, self.rows as u32, self.cols as u32, bits] {
+            out.extend_from_slice(&word.to_le_bytes());
+        }
+        for s in self.blocks.scales() {
             out.extend_from_slice(&s.to_le_bytes());
         }
-        out.extend(self.values.iter().map(|&v| v as u8));
+        out.extend_from_slice(self.blocks.packed());
         out
+    }
+
+    /// The table at `bits` (from its present values).
+    pub fn requantized(&self, bits: Bits) -> WordEmbeddings {
+        Self::quantize(&self.blocks.dequantize(), self.rows, self.cols, bits)
     }
 
     /// Number of rows (vocabulary size).
@@ -533,9 +524,7 @@ impl WordEmbeddings {
         for &id in ids {
             let id = id as usize;
             assert!(id < self.rows, "token id {id} outside the word table");
-            let scale = self.scales[id];
-            let row = &self.values[id * self.cols..(id + 1) * self.cols];
-            out.extend(row.iter().map(|&q| q as f32 * scale));
+            out.extend(self.blocks.values(id * self.cols, self.cols));
         }
         out
     }
@@ -746,7 +735,12 @@ const KEY_MAP: [(&str, &str); 9] = [
 /// Converts the original all-MiniLM-L6-v2 checkpoint (`model_dir` holds HF's
 /// `model.safetensors` and `config.json`) into [`WORDS_FILE`] and [`MODEL_FILE`] in `out_dir`.
 /// The vocabulary is not touched: `minilm-vocab.txt` is HF's `vocab.txt` as is.
-pub fn convert_minilm(model_dir: &Path, out_dir: &Path) -> anyhow::Result<ConvertReport> {
+pub fn convert_minilm(
+    model_dir: &Path,
+    out_dir: &Path,
+    word_bits: Bits,
+    encoder_bits: Bits,
+) -> anyhow::Result<ConvertReport> {
     use anyhow::Context;
     let config = MiniLmConfig::new();
     check_hf_config(&model_dir.join("config.json"), &config)?;
@@ -783,7 +777,7 @@ pub fn convert_minilm(model_dir: &Path, out_dir: &Path) -> anyhow::Result<Conver
         .val()
         .try_into_vec_as::<f32>()
         .map_err(|e| anyhow::anyhow!("reading the word table: {e:?}"))?;
-    let words = WordEmbeddings::quantize(&table, config.vocab_size, config.hidden);
+    let words = WordEmbeddings::quantize(&table, config.vocab_size, config.hidden, word_bits);
     let ids: Vec<u32> = (0..config.vocab_size as u32).collect();
     let words_max_error = words
         .lookup(&ids)
@@ -796,7 +790,7 @@ pub fn convert_minilm(model_dir: &Path, out_dir: &Path) -> anyhow::Result<Conver
     let words_bytes = words.to_bytes();
     std::fs::write(&words_path, &words_bytes).with_context(|| words_path.display().to_string())?;
     let model_path = out_dir.join(MODEL_FILE);
-    let model_bytes = checkpoint.encoder.to_bytes()?;
+    let model_bytes = checkpoint.encoder.to_bytes(encoder_bits)?;
     let model_max_error = max_difference(
         &checkpoint.encoder,
         &MiniLm::from_bytes(&model_bytes, &device)?,
@@ -870,41 +864,7 @@ fn check_hf_config(path: &Path, config: &MiniLmConfig) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn int8_columns_round_trip_within_half_a_step() {
-        let (rows, cols) = (6, 4);
-        let mut m: Vec<f32> = (0..rows * cols)
-            .map(|i| ((i as f32) * 0.71).sin() * (1.0 + i as f32))
-            .collect();
-        for r in 0..rows {
-            m[r * cols + 2] = 0.0; // an all-zero column keeps scale 0
-        }
-        let (q, scales) = quantize_columns(&TensorData::new(m.clone(), [rows, cols])).unwrap();
-        assert_eq!(q.dtype(), DType::I8);
-        assert_eq!(q.shape().to_vec(), [rows, cols]);
-        assert_eq!(scales.shape().to_vec(), [cols]);
-        let s: Vec<f32> = scales.iter::<f32>().collect();
-        assert_eq!(s[2], 0.0);
-        let back = dequantize_columns(&q, &scales).unwrap();
-        for (i, (got, want)) in back.iter().zip(&m).enumerate() {
-            let step = s[i % cols];
-            assert!(
-                (got - want).abs() <= step / 2.0 + 1e-6,
-                "{i}: {got} vs {want}"
-            );
-        }
-        // Each column's largest value is exact (±127 steps).
-        for c in 0..cols {
-            let max = (0..rows)
-                .map(|r| m[r * cols + c].abs())
-                .fold(0f32, f32::max);
-            let got = (0..rows)
-                .map(|r| back[r * cols + c].abs())
-                .fold(0f32, f32::max);
-            assert!((got - max).abs() < 1e-5, "column {c}: {got} vs {max}");
-        }
-    }
+    use burn::store::burn_pack::Writer as PackWriter;
 
     #[test]
     fn bad_scales_are_errors() {
@@ -921,7 +881,7 @@ mod tests {
         );
     }
 
-    /// A burnpack of the given tensors with or without the format tag.
+    /// A burnpack of the given tensors with or without the tag of the columns format.
     fn pack(tensors: Vec<(&str, TensorData)>, tagged: bool) -> Vec<u8> {
         let tensors = tensors
             .into_iter()
@@ -929,7 +889,7 @@ mod tests {
             .collect();
         let mut writer = PackWriter::new(tensors);
         if tagged {
-            writer = writer.with_metadata("format", MiniLm::FORMAT);
+            writer = writer.with_metadata("format", MiniLm::FORMAT_COLUMNS);
         }
         writer.into_bytes().unwrap().to_vec()
     }

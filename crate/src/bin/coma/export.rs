@@ -1,9 +1,10 @@
 //! `coma export`: trained runs assembled into a model folder, and what rounding them to f16
-//! changes.
+//! or quantizing them changes.
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use coma::export::{self, EvaluatorRounding};
+use coma::quant::Bits;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -30,6 +31,10 @@ pub struct ExportArgs {
     data: PathBuf,
     #[arg(long, default_value = "static/models")]
     out: PathBuf,
+    /// Quantize the large tensors to 4 or 8 bits in blocks of 32 (see coma::weights);
+    /// without it every float is rounded to f16.
+    #[arg(long, value_parser = ["4", "8"])]
+    bits: Option<String>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -55,7 +60,14 @@ pub fn run(args: ExportArgs) -> Result<()> {
         res,
         data,
         out,
+        bits,
     } = args;
+    let bits = bits.map(|b| if b == "4" { Bits::Four } else { Bits::Eight });
+    let precision = match bits {
+        None => "f16".to_string(),
+        Some(Bits::Four) => "4-bit".to_string(),
+        Some(Bits::Eight) => "8-bit".to_string(),
+    };
     match what {
         ExportWhat::Random => {
             use burn::config::Config;
@@ -73,23 +85,29 @@ pub fn run(args: ExportArgs) -> Result<()> {
             );
         }
         ExportWhat::Evaluator => {
-            let exported = export::export_evaluator(&evaluator, &out)?;
+            let exported = export::export_evaluator(&evaluator, &out, bits)?;
             println!(
-                "exported the evaluator into {} (f16, {} bytes)",
+                "exported the evaluator into {} ({precision}, {} bytes)",
                 out.display(),
                 exported.bytes
             );
             match exported.rounding(&data) {
                 EvaluatorRounding::NoTestSplit => {
-                    println!("no test split in {}: f16 not compared", data.display())
+                    println!(
+                        "no test split in {}: {precision} not compared",
+                        data.display()
+                    )
                 }
                 EvaluatorRounding::NoSentenceEncoder => {
-                    println!("no sentence encoder in {}: f16 not compared", out.display())
+                    println!(
+                        "no sentence encoder in {}: {precision} not compared",
+                        out.display()
+                    )
                 }
                 EvaluatorRounding::Compared(a) => {
                     let [full, rounded] = a.r_precision;
                     println!(
-                        "f16 against the run's weights on {} random test motions and captions: alignment \
+                        "{precision} against the run's weights on {} random test motions and captions: alignment \
                          scores (0-100) differ by at most {:.4} (mean {:.5}); R-precision top-1 {:.4} -> {:.4}, \
                          top-3 {:.4} -> {:.4}; {} captions change their nearest motion",
                         a.pairs,
@@ -105,9 +123,9 @@ pub fn run(args: ExportArgs) -> Result<()> {
             }
         }
         ExportWhat::Spam => {
-            let exported = export::export_spam(&vq, &base, res.as_deref(), &data, &out)?;
+            let exported = export::export_spam(&vq, &base, res.as_deref(), &data, &out, bits)?;
             println!(
-                "exported SPAM ({}) into {}: f16, {} bytes, model id {}",
+                "exported SPAM ({}) into {}: {precision}, {} bytes, model id {}",
                 if exported.has_residual() {
                     "with its residual transformer"
                 } else {
@@ -119,12 +137,12 @@ pub fn run(args: ExportArgs) -> Result<()> {
             );
             let e = exported.vq_rounding(&data)?;
             println!(
-                "VQ-VAE on {} test motions, {} of {} layers: {:.2} mm (f32) -> {:.2} mm (f16), root aligned",
-                e.motions, e.layers, e.vq_layers, e.f32_mm, e.f16_mm
+                "VQ-VAE on {} test motions, {} of {} layers: {:.2} mm (f32) -> {:.2} mm ({precision}), root aligned",
+                e.motions, e.layers, e.vq_layers, e.f32_mm, e.shipped_mm
             );
             let t = exported.token_rounding()?;
             println!(
-                "greedily decoded tokens of 4 prompts (196 frames): {} of {} the same with f16 as with f32",
+                "greedily decoded tokens of 4 prompts (196 frames): {} of {} the same with {precision} as with f32",
                 t.same, t.total
             );
         }

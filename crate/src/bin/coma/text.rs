@@ -2,6 +2,7 @@
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
+use coma::quant::Bits;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -20,13 +21,30 @@ enum TextCommand {
         from: PathBuf,
         #[arg(long, default_value = "static/models")]
         out: PathBuf,
+        /// Bits per value of the word table (the shipped file uses 4).
+        #[arg(long, value_parser = ["4", "8"], default_value = "4")]
+        word_bits: String,
+        /// Bits per value of the encoder's matrices (the shipped file uses 8).
+        #[arg(long, value_parser = ["4", "8"], default_value = "8")]
+        encoder_bits: String,
     },
 }
 
 pub fn run(args: TextArgs) -> Result<()> {
     match args.command {
-        TextCommand::Convert { from, out } => {
-            let report = coma::text::minilm::convert_minilm(&from, &out)?;
+        TextCommand::Convert {
+            from,
+            out,
+            word_bits,
+            encoder_bits,
+        } => {
+            let bits = |b: String| if b == "4" { Bits::Four } else { Bits::Eight };
+            let report = coma::text::minilm::convert_minilm(
+                &from,
+                &out,
+                bits(word_bits),
+                bits(encoder_bits),
+            )?;
             println!("{report:?}");
         }
     }
