@@ -4,15 +4,15 @@
 //! The page downloads the weights, so they are split in two files, neither needing the file
 //! system to load:
 //!
-//! - `minilm-words.i8`: the 30522 × 384 word-embedding table, 47 MB in f32, quantised to int8
-//!   with one f32 scale per row (see [`WordEmbeddings`] for the format). It is read on the CPU
-//!   in plain Rust because a sentence touches a dozen of its rows: giving the whole table to
-//!   the tensor backend would cost memory for nothing.
-//! - `minilm-encoder.bpk`: everything else ([`MiniLm`]), 11 MB: a burnpack whose 36 Linear
-//!   weight matrices (attention query/key/value/output and the two feed-forward matrices of
-//!   each of the 6 layers, 10.6 M of the 10.8 M values) are int8 with one f32 scale per output,
-//!   and whose other tensors are f16 (see [`MiniLm`] for the format). Everything is widened to
-//!   f32 on load, so the encoder computes in f32.
+//! - `minilm-words.i8`: the 30522 × 384 word-embedding table, 47 MB in f32, quantized in
+//!   blocks ([`crate::quant`]; 6.6 MB at the shipped 4 bits, see [`WordEmbeddings`] for the
+//!   format). It is read on the CPU in plain Rust because a sentence touches a dozen of its
+//!   rows: giving the whole table to the tensor backend would cost memory for nothing.
+//! - `minilm-encoder.bpk`: everything else ([`MiniLm`]), 11 MB: a burnpack in
+//!   [`crate::weights`]' layout whose matrices and embeddings (the 36 Linear weights of the 6
+//!   layers are 10.6 M of the 10.8 M values) are quantized in blocks (8 bits shipped) and
+//!   whose other tensors are f16. Everything is widened to f32 on load, so the encoder
+//!   computes in f32.
 //!
 //! [`convert_minilm`] writes both from the original `model.safetensors`; [`SentenceEncoder`]
 //! ties them to the tokenizer. Results match sentence-transformers (mean pooling over real
@@ -37,7 +37,7 @@ pub const EMBEDDING_DIM: usize = 384;
 
 /// The vocabulary (HF's `vocab.txt` as is) that [`SentenceEncoder::from_dir`] reads.
 pub const VOCAB_FILE: &str = "minilm-vocab.txt";
-/// The int8 word-embedding table (see [`WordEmbeddings`]) written by [`convert_minilm`].
+/// The quantized word-embedding table (see [`WordEmbeddings`]) written by [`convert_minilm`].
 pub const WORDS_FILE: &str = "minilm-words.i8";
 
 /// Bits per value of the shipped word table (`static/models`): 4 bits halve its download,
@@ -48,7 +48,7 @@ pub const SHIPPED_WORD_BITS: Bits = Bits::Four;
 /// Bits per value of the shipped encoder's matrices: at 4 bits a sentence's embedding drifts
 /// to 0.97 cosine of the reference ("a person walks forward"), too far to keep.
 pub const SHIPPED_ENCODER_BITS: Bits = Bits::Eight;
-/// The burnpack of the rest of the encoder ([`MiniLm`], int8 Linear weights) written by
+/// The burnpack of the rest of the encoder ([`MiniLm`], quantized matrices) written by
 /// [`convert_minilm`].
 pub const MODEL_FILE: &str = "minilm-encoder.bpk";
 
@@ -161,9 +161,10 @@ impl EncoderLayer {
 ///  token states [B, L, 384]
 /// ```
 ///
-/// File format ([`MODEL_FILE`], written by [`Self::to_bytes`]): a burnpack container (burn's
-/// own format, read with `burn::store::burn_pack`) with metadata `format` =
-/// [`Self::FORMAT`], and one tensor per parameter, named by its path in this module:
+/// File format ([`MODEL_FILE`]): [`Self::to_bytes`] writes [`crate::weights`]' layout with
+/// metadata `format` = [`Self::FORMAT`], tensors named by their path in this module.
+/// [`Self::from_bytes`] also reads the earlier [`Self::FORMAT_COLUMNS`]: a burnpack container
+/// (burn's own format) with one tensor per parameter:
 ///
 /// | tensors | dtype | shape | content |
 /// |---|---|---|---|
@@ -540,7 +541,7 @@ impl std::fmt::Debug for WordEmbeddings {
     }
 }
 
-/// all-MiniLM-L6-v2 end to end: tokenizer, int8 word table and burn encoder on one device.
+/// all-MiniLM-L6-v2 end to end: tokenizer, quantized word table and burn encoder on one device.
 pub struct SentenceEncoder {
     tokenizer: Tokenizer,
     words: WordEmbeddings,
@@ -671,7 +672,7 @@ impl SentenceEncoder {
 /// What [`convert_minilm`] wrote.
 #[derive(Clone, Debug)]
 pub struct ConvertReport {
-    /// The int8 word-embedding table.
+    /// The quantized word-embedding table.
     pub words_path: PathBuf,
     /// Its size in bytes.
     pub words_bytes: u64,
