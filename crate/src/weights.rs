@@ -114,15 +114,7 @@ pub fn read_widened(bytes: &[u8]) -> Result<(Vec<PackTensor>, BTreeMap<String, S
         .into_iter()
         .map(|t| (t.name.clone(), t))
         .collect();
-    let scale_names: Vec<String> = tensors
-        .keys()
-        .filter(|name| name.ends_with(SCALES_SUFFIX))
-        .cloned()
-        .collect();
-    let mut scales: BTreeMap<String, PackTensor> = scale_names
-        .into_iter()
-        .filter_map(|name| tensors.remove_entry(&name))
-        .collect();
+    let mut scales = take_suffixed(&mut tensors, SCALES_SUFFIX);
     let mut widened = Vec::with_capacity(tensors.len());
     for (name, tensor) in tensors {
         let data = bridge::into_data(tensor).map_err(pack)?;
@@ -168,6 +160,23 @@ pub fn read_widened(bytes: &[u8]) -> Result<(Vec<PackTensor>, BTreeMap<String, S
         return Err(format!("{name} scales no tensor"));
     }
     Ok((widened, metadata))
+}
+
+/// Takes out of `tensors` those whose names end with `suffix` (the scales stored beside
+/// quantized tensors), by name.
+pub(crate) fn take_suffixed(
+    tensors: &mut BTreeMap<String, PackTensor>,
+    suffix: &str,
+) -> BTreeMap<String, PackTensor> {
+    let names: Vec<String> = tensors
+        .keys()
+        .filter(|name| name.ends_with(suffix))
+        .cloned()
+        .collect();
+    names
+        .into_iter()
+        .filter_map(|name| tensors.remove_entry(&name))
+        .collect()
 }
 
 /// `module` with the parameters of a burnpack's bytes (f32, f16 or quantized, widened to

@@ -239,15 +239,7 @@ impl MiniLm {
         let pack = |e: burn::store::burn_pack::Error| MiniLmError::Model(e.to_string());
         let mut tensors: BTreeMap<String, PackTensor> =
             tensors.into_iter().map(|t| (t.name.clone(), t)).collect();
-        let scale_names: Vec<String> = tensors
-            .keys()
-            .filter(|name| name.ends_with(Self::SCALE_SUFFIX))
-            .cloned()
-            .collect();
-        let mut scales: BTreeMap<String, PackTensor> = scale_names
-            .into_iter()
-            .filter_map(|name| tensors.remove_entry(&name))
-            .collect();
+        let mut scales = crate::weights::take_suffixed(&mut tensors, Self::SCALE_SUFFIX);
         let mut widened = Vec::with_capacity(tensors.len());
         for (name, tensor) in tensors {
             if tensor.dtype != DType::I8 {
