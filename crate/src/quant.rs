@@ -192,9 +192,18 @@ impl Blocks {
             start + count <= self.len,
             "values past the end of the blocks"
         );
-        (start..start + count)
-            .map(|i| self.q(i) as f32 * self.scales[i / self.bits.block()].to_f32())
-            .collect()
+        // Block by block, so each scale is widened once: loading dequantizes millions of
+        // values.
+        let (block, end) = (self.bits.block(), start + count);
+        let mut out = Vec::with_capacity(count);
+        let mut i = start;
+        while i < end {
+            let stop = ((i / block + 1) * block).min(end);
+            let scale = self.scales[i / block].to_f32();
+            out.extend((i..stop).map(|k| self.q(k) as f32 * scale));
+            i = stop;
+        }
+        out
     }
 
     /// Every value, dequantized.
