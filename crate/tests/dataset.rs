@@ -18,9 +18,10 @@ fn small_build_writes_the_humanml3d_layout() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/bandai-namco-bvh.tar.xz");
     let lines = std::sync::Mutex::new(Vec::new());
     let options = BuildOptions {
-        source: archive,
+        bandai: Some(archive),
         out: out.clone(),
         limit: Some(40),
+        ..Default::default()
     };
     let summary = build(&options, &|l| lines.lock().unwrap().push(l.to_string())).unwrap();
     assert!(
@@ -123,6 +124,7 @@ fn small_build_writes_the_humanml3d_layout() {
         assert!(json.get(key).is_some(), "dataset.json has {key}");
     }
     assert_eq!(json["licence"], "CC BY-NC 4.0");
+    assert_eq!(json["sources"]["bandai"]["source_clips"], 40);
     assert!(json["vocabulary"]["words"].as_array().unwrap().len() > 20);
     assert!(
         !out.with_extension("partial").exists(),
@@ -135,9 +137,10 @@ fn full_build_has_enough_clips_and_hours() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("bandai");
     let options = BuildOptions {
-        source: archive(),
+        bandai: Some(archive()),
         out: out.clone(),
         limit: None,
+        ..Default::default()
     };
     let summary = build(&options, &|_| {}).unwrap();
     assert_eq!(summary.source_clips, 3076);
@@ -154,9 +157,20 @@ fn full_build_has_enough_clips_and_hours() {
         "wave-right-hand",
         "raise-up-left-hand",
         "run",
-        "kick",
     ] {
         assert!(actions.contains_key(action), "vocabulary has {action}");
+    }
+    // Kicks and punches carry the side the motion shows, and mirrors the other.
+    for sided in [
+        "kick-left-leg",
+        "kick-right-leg",
+        "punch-left-hand",
+        "punch-right-hand",
+    ] {
+        assert!(
+            actions.contains_key(sided),
+            "vocabulary has {sided}: {actions:?}"
+        );
     }
 }
 
@@ -164,9 +178,10 @@ fn full_build_has_enough_clips_and_hours() {
 fn missing_archive_gives_a_clear_error() {
     let tmp = tempfile::tempdir().unwrap();
     let options = BuildOptions {
-        source: tmp.path().join("nope.tar.xz"),
+        bandai: Some(tmp.path().join("nope.tar.xz")),
         out: tmp.path().join("out"),
         limit: None,
+        ..Default::default()
     };
     let err = build(&options, &|_| {}).unwrap_err();
     assert!(format!("{err:#}").contains("nope.tar.xz"), "{err:#}");
@@ -186,9 +201,10 @@ fn training_loads_the_split_crops_it_and_resumes_a_run() {
     let out = tmp.path().join("bandai");
     build(
         &BuildOptions {
-            source: archive(),
+            bandai: Some(archive()),
             out: out.clone(),
             limit: Some(12),
+            ..Default::default()
         },
         &|_| {},
     )
@@ -220,6 +236,7 @@ fn training_loads_the_split_crops_it_and_resumes_a_run() {
         data: out.clone(),
         run_dir: run.clone(),
         minutes: None,
+        init: None,
     };
     let lines = std::sync::Mutex::new(Vec::new());
     let device = Device::flex().autodiff();
@@ -250,4 +267,89 @@ fn training_loads_the_split_crops_it_and_resumes_a_run() {
     assert!(run.join("vq.bpk").exists());
     let log = std::fs::read_to_string(run.join("log.csv")).unwrap();
     assert_eq!(log.lines().count(), 4, "header and three steps:\n{log}");
+}
+
+#[test]
+fn every_source_builds_into_one_dataset_split_by_actor() {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("all");
+    let summary = build(
+        &BuildOptions {
+            bandai: Some(archive()),
+            hdm05: Some(shared.join("hdm05-subset/hdm05-subset-amc.tar.xz")),
+            cmu: Some(shared.join("cmu-8action-expmap/cmu-8action-expmap.tar.xz")),
+            deepmimic: Some(shared.join("deepmimic")),
+            out: out.clone(),
+            limit: Some(30),
+        },
+        &|_| {},
+    )
+    .unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("dataset.json")).unwrap()).unwrap();
+    for (source, licence) in [
+        ("bandai", "CC BY-NC 4.0"),
+        ("hdm05", "CC BY-SA 3.0"),
+        ("deepmimic", "MIT"),
+    ] {
+        assert_eq!(json["sources"][source]["licence"], licence, "{source}");
+        assert!(json["licence"].as_str().unwrap().contains(licence));
+    }
+    assert!(json["sources"]["cmu"]["source_clips"].as_u64().unwrap() > 0);
+    assert!(json["attribution"].as_str().unwrap().contains("HDM05"));
+
+    // HDM05's test actor never trains; every other HDM05 actor does.
+    let hdm: Vec<_> = summary
+        .items
+        .iter()
+        .filter(|i| i.source == coma::dataset::Source::Hdm05)
+        .collect();
+    assert!(!hdm.is_empty());
+    for item in &hdm {
+        let test_actor = coma::dataset::HDM05_TEST_ACTORS.contains(&item.actor.as_str());
+        assert_eq!(
+            item.split == coma::dataset::Split::Test,
+            test_actor,
+            "{} by {}",
+            item.name,
+            item.actor
+        );
+    }
+
+    // New actions arrive with their own words, and mirrors swap the side of one-sided ones.
+    let actions = json["vocabulary"]["actions"].as_object().unwrap();
+    for action in ["squat", "lie-down", "kick-left-leg", "kick-right-leg"] {
+        assert!(actions.contains_key(action), "{action}: {actions:?}");
+    }
+    let kick = summary
+        .items
+        .iter()
+        .find(|i| i.content == "kick-left-leg" && i.source == coma::dataset::Source::Hdm05)
+        .unwrap();
+    assert!(kick.captions.iter().all(|c| c.contains("left")));
+    let mirror = summary
+        .items
+        .iter()
+        .find(|i| i.name == format!("M{}", kick.name))
+        .unwrap();
+    assert_eq!(mirror.content, "kick-right-leg");
+    assert!(mirror
+        .captions
+        .iter()
+        .all(|c| c.contains("right") && !c.contains("left")));
+}
+
+#[test]
+fn no_source_at_all_is_a_clear_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = build(
+        &BuildOptions {
+            out: tmp.path().join("out"),
+            ..Default::default()
+        },
+        &|_| {},
+    )
+    .unwrap_err();
+    assert!(format!("{err:#}").contains("--hdm05"), "{err:#}");
 }

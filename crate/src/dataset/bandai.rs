@@ -101,26 +101,10 @@ impl Collected {
             bail!("no BVH clips found");
         }
         if let Selection::Spread(n) = selection {
-            clips = spread(clips, *n);
+            clips = super::spread(clips, *n);
         }
         Ok(clips)
     }
-}
-
-/// Up to `n` clips spread evenly over the sorted list, so a small build still sees many
-/// contents and styles.
-fn spread(clips: Vec<SourceClip>, n: usize) -> Vec<SourceClip> {
-    if n >= clips.len() {
-        return clips;
-    }
-    let step = clips.len() as f64 / n as f64;
-    let wanted: Vec<usize> = (0..n).map(|i| (i as f64 * step) as usize).collect();
-    clips
-        .into_iter()
-        .enumerate()
-        .filter(|(i, _)| wanted.binary_search(i).is_ok())
-        .map(|(_, c)| c)
-        .collect()
 }
 
 fn wanted(path: &str) -> bool {

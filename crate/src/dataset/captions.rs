@@ -11,8 +11,9 @@ pub fn mirror_content(content: &str) -> String {
     }
 }
 
-/// Ways to say what the motion is, third person present, without a subject.
-fn action_phrases(content: &str) -> &'static [&'static str] {
+/// Ways to say what the motion is, third person present, without a subject, for labels
+/// worded as a whole (sided labels of the sources that name the side themselves included).
+fn fixed_phrases(content: &str) -> &'static [&'static str] {
     match content {
         "walk" => &[
             "walks forward",
@@ -119,8 +120,239 @@ fn action_phrases(content: &str) -> &'static [&'static str] {
             "lifts the right arm up",
             "raises the right hand up high",
         ],
+        "squat" => &[
+            "does a squat",
+            "squats down and stands back up",
+            "bends the knees into a deep squat and rises again",
+            "crouches down into a squat, then stands up",
+        ],
+        "jump" => &["jumps", "jumps up", "does a jump", "jumps with both feet"],
+        "jump-forward" => &[
+            "jumps forward with both feet",
+            "hops forward on both legs",
+            "does a two-footed jump forward",
+            "leaps forward with the feet together",
+        ],
+        "lie-down" => &[
+            "lies down on the floor",
+            "gets down and lies on the ground",
+            "lowers the body to lie flat on the floor",
+            "kneels and then lies down on the ground",
+        ],
+        "elbow-to-knee" => &[
+            "touches each elbow to the opposite knee",
+            "does an elbow-to-knee exercise",
+            "twists to bring the elbows to the opposite knees",
+        ],
+        "jog-circle-left" => &[
+            "jogs in a circle to the left",
+            "runs slowly in a counterclockwise circle",
+            "jogs around, curving to the left",
+        ],
+        "jog-circle-right" => &[
+            "jogs in a circle to the right",
+            "runs slowly in a clockwise circle",
+            "jogs around, curving to the right",
+        ],
+        "arm-circles" => &[
+            "circles both arms backward",
+            "rotates both arms backwards",
+            "swings both arms around in backward circles",
+        ],
+        "sneak" => &[
+            "sneaks forward",
+            "tiptoes forward quietly",
+            "walks stealthily",
+            "creeps forward carefully",
+        ],
+        "throw" => &[
+            "throws a ball",
+            "throws a basketball",
+            "makes a throwing motion",
+        ],
+        "basketball" => &[
+            "plays basketball",
+            "dribbles and shoots a basketball",
+            "dribbles a ball and shoots",
+        ],
+        "referee-signals" => &[
+            "makes referee signals with the arms",
+            "signals with both arms like a referee",
+            "gestures like a basketball referee",
+        ],
+        "direct-traffic" => &[
+            "directs traffic with arm signals",
+            "waves the arms to direct traffic",
+            "signals to cars with the arms like a traffic officer",
+        ],
+        "kick-ball" => &[
+            "kicks a ball",
+            "kicks a soccer ball",
+            "plays soccer, kicking the ball",
+        ],
+        "wash-window" => &[
+            "washes a window",
+            "wipes a window in circles",
+            "cleans a window with one hand",
+        ],
+        "backflip" => &[
+            "does a backflip",
+            "flips over backwards",
+            "jumps and flips backwards",
+        ],
+        "cartwheel" => &[
+            "does a cartwheel",
+            "turns a cartwheel",
+            "cartwheels sideways",
+        ],
+        "crawl" => &[
+            "crawls on hands and knees",
+            "crawls forward",
+            "crawls forward on all fours",
+        ],
+        "dance" => &["dances", "dances energetically", "performs a dance"],
+        "dance-spin" => &[
+            "dances and spins around",
+            "spins around while dancing",
+            "twirls around in a dance",
+        ],
+        "get-up-face-down" => &[
+            "gets up from lying face down",
+            "pushes up off the floor and stands up",
+            "rises from lying on the stomach",
+        ],
+        "get-up-face-up" => &[
+            "gets up from lying on the back",
+            "sits up and stands up from the floor",
+            "rises from lying face up",
+        ],
+        "jog" => &["jogs forward", "jogs", "runs at an easy pace"],
+        "start-walking" => &[
+            "starts walking from standing",
+            "begins to walk forward",
+            "stands still, then walks off",
+        ],
+        "stop-walking" => &[
+            "walks and comes to a stop",
+            "walks forward and stops",
+            "slows down and stops walking",
+        ],
+        "roll" => &[
+            "rolls forward on the ground",
+            "does a forward roll",
+            "tumbles forward",
+        ],
+        "sideflip" => &[
+            "does a side flip",
+            "flips sideways in the air",
+            "does an aerial side flip",
+        ],
+        "spin" => &[
+            "spins around",
+            "turns around in a full spin",
+            "spins in place",
+        ],
+        "spin-kick" => &[
+            "does a spinning kick",
+            "spins and kicks",
+            "turns around and kicks",
+        ],
+        "zombie-walk" => &[
+            "walks like a zombie",
+            "shuffles forward like a zombie with the arms out",
+            "staggers forward like a zombie",
+        ],
         _ => &[],
     }
+}
+
+/// Wordings with a `{side}` slot for actions done with one limb, keyed by the label without
+/// its `-left-leg` / `-right-hand` ending.
+fn sided_phrases(base: &str) -> &'static [&'static str] {
+    match base {
+        "kick" => &[
+            "kicks with the {side} leg",
+            "kicks forward with the {side} foot",
+            "does a front kick with the {side} leg",
+        ],
+        "kick-ball" => &[
+            "kicks a ball with the {side} foot",
+            "kicks a soccer ball with the {side} leg",
+            "plays soccer, kicking with the {side} foot",
+        ],
+        "spin-kick" => &[
+            "does a spinning kick with the {side} leg",
+            "spins and kicks with the {side} foot",
+        ],
+        "punch" => &[
+            "punches with the {side} hand",
+            "throws a {side} punch",
+            "punches forward with the {side} fist",
+        ],
+        "slash" => &[
+            "slashes with the {side} hand as if with a sword",
+            "swings the {side} arm in a slashing motion",
+        ],
+        "throw" => &[
+            "throws a ball with the {side} hand",
+            "throws a basketball with the {side} hand",
+            "makes a throwing motion with the {side} arm",
+        ],
+        "put-down" => &[
+            "bends down and puts something on the floor with the {side} hand",
+            "places an object on the ground with the {side} hand",
+            "crouches to set something down with the {side} hand",
+        ],
+        "reach-up" => &[
+            "reaches up high with the {side} hand",
+            "reaches up and grabs something high with the {side} hand",
+            "stretches the {side} arm up to take something from a high shelf",
+        ],
+        _ => &[],
+    }
+}
+
+/// Splits `kick-left-leg` into `kick` and `left`; `None` for labels without a side ending.
+fn side_ending(content: &str) -> Option<(&str, &'static str)> {
+    for (ending, side) in [
+        ("-left-leg", "left"),
+        ("-right-leg", "right"),
+        ("-left-hand", "left"),
+        ("-right-hand", "right"),
+    ] {
+        if let Some(base) = content.strip_suffix(ending) {
+            return Some((base, side));
+        }
+    }
+    None
+}
+
+/// Ways to say what the motion is, third person present, without a subject; empty for labels
+/// we have no wording for.
+fn action_phrases(content: &str) -> Vec<String> {
+    let fixed = fixed_phrases(content);
+    if !fixed.is_empty() {
+        return fixed.iter().map(|p| p.to_string()).collect();
+    }
+    let Some((base, side)) = side_ending(content) else {
+        return Vec::new();
+    };
+    let templates = sided_phrases(base);
+    if !templates.is_empty() {
+        return templates
+            .iter()
+            .map(|t| t.replace("{side}", side))
+            .collect();
+    }
+    let limb = if content.ends_with("-leg") {
+        "leg"
+    } else {
+        "hand"
+    };
+    fixed_phrases(base)
+        .iter()
+        .map(|p| format!("{p} with the {side} {limb}"))
+        .collect()
 }
 
 /// A fallback phrase for content labels we have no wording for: the label's words.
@@ -219,11 +451,10 @@ pub fn stable_hash(text: &str) -> u64 {
 
 /// `count` distinct global captions for a clip, chosen deterministically from `seed`.
 pub fn global_captions(content: &str, style: &str, seed: &str, count: usize) -> Vec<String> {
-    let fallback = [label_phrase(content)];
-    let actions: Vec<&str> = match action_phrases(content) {
-        [] => fallback.iter().map(String::as_str).collect(),
-        a => a.to_vec(),
-    };
+    let mut actions = action_phrases(content);
+    if actions.is_empty() {
+        actions.push(label_phrase(content));
+    }
     let style = style_words(style);
     let mut candidates = Vec::new();
     for (i, action) in actions.iter().enumerate() {
@@ -291,5 +522,34 @@ mod tests {
     fn unknown_labels_still_get_words() {
         let c = global_captions("cartwheel", "normal", "x", 2);
         assert!(c.iter().all(|c| c.contains("cartwheel")), "{c:?}");
+        let c = global_captions("moonwalk", "normal", "x", 2);
+        assert!(c.iter().all(|c| c.contains("moonwalk")), "{c:?}");
+    }
+
+    #[test]
+    fn sided_labels_name_their_side_and_mirror() {
+        for content in [
+            "kick-left-leg",
+            "punch-left-hand",
+            "kick-ball-left-leg",
+            "put-down-left-hand",
+            "throw-left-hand",
+            "spin-kick-left-leg",
+        ] {
+            let c = global_captions(content, "normal", "clip", 3);
+            assert_eq!(c.len(), 3, "{content}: {c:?}");
+            assert!(
+                c.iter().all(|c| c.contains("left") && !c.contains("right")),
+                "{content}: {c:?}"
+            );
+            let m = global_captions(&mirror_content(content), "normal", "clip", 3);
+            assert!(
+                m.iter().all(|c| c.contains("right") && !c.contains("left")),
+                "{content}: {m:?}"
+            );
+        }
+        assert!(global_captions("kick-left-leg", "normal", "x", 3)
+            .iter()
+            .all(|c| c.contains("kick")));
     }
 }

@@ -1,6 +1,8 @@
-//! The training dataset: Bandai-Namco motion capture converted into the HumanML3D layout.
+//! The training dataset: every motion capture source we have, converted into one dataset in
+//! the HumanML3D layout.
 //!
-//! `coma data build --bandai <archive> --out <dir>` writes:
+//! `coma data build [--bandai <archive>] [--hdm05 <archive>] [--cmu <archive>]
+//! [--deepmimic <folder>] --out <dir>` (each source optional, at least one) writes:
 //!
 //! | path                    | content                                                        |
 //! |-------------------------|----------------------------------------------------------------|
@@ -8,20 +10,25 @@
 //! | `new_joints/<n>.npy`    | (T, 22, 3) float32 joints recovered from those features, metres |
 //! | `texts/<n>.txt`         | global captions, one per line, HumanML3D style: `caption#tokens#0.0#0.0`, tokens are the lower-cased words tagged `/OTHER` (we run no part-of-speech tagger) |
 //! | `part_texts/<n>.txt`    | one line per body part: `left arm#<sentence>` (also `right arm`, `left leg`, `right leg`), from the pose-code describer |
-//! | `train.txt` `val.txt` `test.txt` | item names, split by source clip: every window and mirror of a clip is in one split |
+//! | `train.txt` `val.txt` `test.txt` | item names, split by source clip and actor: every window and mirror of a clip is in one split, and no test actor performs in training ([`Source::split`]) |
 //! | `Mean.npy` `Std.npy`    | (263,) float32 statistics of the training split              |
-//! | `dataset.json`          | counts, hours, licence, vocabulary and every item's record    |
+//! | `dataset.json`          | counts, hours, licences per source, vocabulary and every item's record |
 //!
-//! Item names: the source file stem with the dataset shortened (`bn2_wave-left-hand_normal_001`),
+//! Item names: the source file stem (`HDM_bd_squat1Reps_001`, `cmu_train_soccer_3`,
+//! `deepmimic_kick`; Bandai-Namco's with the dataset shortened, `bn2_wave-left-hand_normal_001`),
 //! `_w<k>` when a long clip is cut into windows, and an `M` prefix for the left/right mirror
-//! (whose captions swap left and right).
+//! (whose labels and captions swap left and right). Source labels become our content labels in
+//! [`labels`] (one-sided actions get the side the motion shows).
 
 pub mod bandai;
 pub mod captions;
+pub mod labels;
 pub mod motions;
 
 use crate::bvh::{self, Bvh};
 use crate::features::{self, FeatureStats};
+use crate::geom;
+use crate::mocap;
 use crate::posecodes;
 use crate::skeleton::{self, Offsets, Pose};
 use crate::timing::{FPS, MAX_FRAMES};
@@ -39,10 +46,66 @@ use std::time::Instant;
 pub const MIN_FRAMES: usize = 20;
 /// Global captions written per item.
 pub const CAPTIONS_PER_ITEM: usize = 4;
-/// Licence of the source data, which every derived file and weight inherits.
-pub const LICENCE: &str = "CC BY-NC 4.0";
-/// Attribution required by the licence.
-pub const ATTRIBUTION: &str = "Bandai Namco Research Motion Datasets 1 and 2 (Kobayashi et al. 2023, \"Motion Capture Dataset for Practical Use of AI-based Motion Editing and Stylization\", arXiv:2306.08861)";
+/// HDM05 actors whose clips are held out for testing (one of five; every class has clips by
+/// this actor), so no test performer is seen in training.
+pub const HDM05_TEST_ACTORS: [&str; 1] = ["tr"];
+
+/// A motion capture source, with the terms its derived files and weights carry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Source {
+    Bandai,
+    Hdm05,
+    Cmu,
+    DeepMimic,
+}
+
+impl Source {
+    /// The licence of the source data, which every derived file inherits.
+    pub fn licence(self) -> &'static str {
+        match self {
+            Source::Bandai => "CC BY-NC 4.0",
+            Source::Hdm05 => "CC BY-SA 3.0",
+            Source::Cmu => {
+                "CMU Graphics Lab Motion Capture Database terms (free to use, not to resell)"
+            }
+            Source::DeepMimic => "MIT",
+        }
+    }
+
+    /// The attribution the licence asks for.
+    pub fn attribution(self) -> &'static str {
+        match self {
+            Source::Bandai => "Bandai Namco Research Motion Datasets 1 and 2 (Kobayashi et al. 2023, \"Motion Capture Dataset for Practical Use of AI-based Motion Editing and Stylization\", arXiv:2306.08861)",
+            Source::Hdm05 => "The data used in this project was obtained from HDM05 (Müller, Röder, Clausen, Eberhardt, Krüger, Weber, \"Documentation Mocap Database HDM05\", Tech. Rep. CG-2007-2, Universität Bonn, 2007). Converted motion files are CC BY-SA 3.0 (ShareAlike).",
+            Source::Cmu => "The data used in this project was obtained from mocap.cs.cmu.edu, created with funding from NSF EIA-0196217; exponential-map conversion by Li et al. (CVPR 2018, MIT) as distributed by DMGNN (MIT)",
+            Source::DeepMimic => "DeepMimic motion clips, Copyright (c) 2018 Xue Bin Peng (MIT licence)",
+        }
+    }
+
+    /// Which split a clip of this source goes to, when the source itself decides it: HDM05 by
+    /// actor, CMU by the source's own split, DeepMimic always training (one clip per action,
+    /// so holding one out would remove the action). `None` for Bandai-Namco, which is split
+    /// by clip within each label ([`assign_splits`]).
+    pub fn split(self, actor: &str, source_test: bool) -> Option<Split> {
+        match self {
+            Source::Bandai => None,
+            Source::Hdm05 if HDM05_TEST_ACTORS.contains(&actor) => Some(Split::Test),
+            Source::Cmu if source_test => Some(Split::Test),
+            _ => Some(Split::Train),
+        }
+    }
+}
+
+impl From<mocap::Source> for Source {
+    fn from(s: mocap::Source) -> Source {
+        match s {
+            mocap::Source::Hdm05 => Source::Hdm05,
+            mocap::Source::Cmu => Source::Cmu,
+            mocap::Source::DeepMimic => Source::DeepMimic,
+        }
+    }
+}
 
 /// Which part of the data an item belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -64,14 +127,20 @@ impl Split {
     }
 }
 
-/// What to build.
-#[derive(Clone, Debug)]
+/// What to build. Every source is optional; at least one must be given.
+#[derive(Clone, Debug, Default)]
 pub struct BuildOptions {
     /// The Bandai-Namco `.tar.xz` archive or a folder it was extracted into.
-    pub source: PathBuf,
+    pub bandai: Option<PathBuf>,
+    /// HDM05's `hdm05-subset-amc.tar.xz` or its extracted folder.
+    pub hdm05: Option<PathBuf>,
+    /// CMU's `cmu-8action-expmap.tar.xz` or its extracted folder.
+    pub cmu: Option<PathBuf>,
+    /// The `deepmimic` folder (`humanoid3d.txt` and `motions/`).
+    pub deepmimic: Option<PathBuf>,
     /// Output folder (replaced only once the new build is complete).
     pub out: PathBuf,
-    /// Use only this many source clips, spread over the whole set (for quick builds and tests).
+    /// Use only this many clips of each source, spread over it (for quick builds and tests).
     pub limit: Option<usize>,
 }
 
@@ -79,8 +148,11 @@ pub struct BuildOptions {
 #[derive(Clone, Debug, Serialize)]
 pub struct ItemRecord {
     pub name: String,
+    pub source: Source,
     /// Source file stem.
     pub clip: String,
+    /// Who performed it, where the source says (HDM05's actors); else a name for the source.
+    pub actor: String,
     pub split: Split,
     /// Feature rows (frames at 20 fps).
     pub frames: usize,
@@ -93,12 +165,31 @@ pub struct ItemRecord {
     pub parts: BTreeMap<String, String>,
 }
 
+/// What one source contributed, in `dataset.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SourceSummary {
+    pub licence: String,
+    pub attribution: String,
+    /// Source clips read.
+    pub source_clips: usize,
+    /// Items written per split, mirrors included.
+    pub items: BTreeMap<Split, usize>,
+    /// Feature rows over its items.
+    pub frames: usize,
+    /// Items per content label.
+    pub actions: BTreeMap<String, usize>,
+}
+
 /// Summary written as `dataset.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct DatasetSummary {
     pub name: String,
+    /// The licences of the sources used, joined; the strictest terms bind the whole (weights
+    /// trained on Bandai-Namco are non-commercial).
     pub licence: String,
     pub attribution: String,
+    /// Per source: counts and terms.
+    pub sources: BTreeMap<Source, SourceSummary>,
     pub fps: f64,
     pub feature_dim: usize,
     pub max_frames: usize,
@@ -209,6 +300,24 @@ fn item_name(stem: &str, window: usize, windows: usize, mirrored: bool) -> Strin
     }
 }
 
+/// A source clip of any source, before conversion.
+struct Clip {
+    source: Source,
+    stem: String,
+    actor: String,
+    reading: labels::Reading,
+    style: String,
+    split: Split,
+    motion: ClipMotion,
+}
+
+/// A clip's motion as its reader gives it: Bandai-Namco's BVH text is parsed in the parallel
+/// conversion, the other readers hand over joint positions.
+enum ClipMotion {
+    Bvh(String),
+    Poses(Vec<Pose>),
+}
+
 /// Everything derived from one window, before it is written.
 struct Item {
     record: ItemRecord,
@@ -216,9 +325,19 @@ struct Item {
     joints: Vec<Pose>,
 }
 
-fn process_clip(clip: &bandai::SourceClip, split: Split) -> Result<Vec<Item>> {
-    let bvh = Bvh::parse(&clip.bvh).with_context(|| format!("{}.bvh", clip.stem))?;
-    let poses = bvh::bandai::retarget(&bvh).with_context(|| format!("{}.bvh", clip.stem))?;
+fn process_clip(clip: &Clip) -> Result<Vec<Item>> {
+    let poses = match &clip.motion {
+        ClipMotion::Bvh(text) => {
+            let bvh = Bvh::parse(text).with_context(|| format!("{}.bvh", clip.stem))?;
+            bvh::bandai::retarget(&bvh).with_context(|| format!("{}.bvh", clip.stem))?
+        }
+        ClipMotion::Poses(poses) => poses.clone(),
+    };
+    if floor_dip(&poses) > MAX_FLOOR_DIP_M {
+        // Skipped (listed in `dataset.json`): the whole clip would float above the floor.
+        return Ok(Vec::new());
+    }
+    let content = labels::content_of(&clip.reading, &poses);
     let target = Offsets::reference();
     let spans = windows(poses.len());
     let mut items = Vec::new();
@@ -229,9 +348,9 @@ fn process_clip(clip: &bandai::SourceClip, split: Split) -> Result<Vec<Item>> {
             poses.clone()
         };
         let content = if mirrored {
-            captions::mirror_content(&clip.content)
+            captions::mirror_content(&content)
         } else {
-            clip.content.clone()
+            content.clone()
         };
         for (w, (start, end)) in spans.iter().enumerate() {
             let name = item_name(&clip.stem, w, spans.len(), mirrored);
@@ -248,8 +367,10 @@ fn process_clip(clip: &bandai::SourceClip, split: Split) -> Result<Vec<Item>> {
                 record: ItemRecord {
                     frames: features.len(),
                     name,
+                    source: clip.source,
                     clip: clip.stem.clone(),
-                    split,
+                    actor: clip.actor.clone(),
+                    split: clip.split,
                     mirrored,
                     content: content.clone(),
                     style: clip.style.clone(),
@@ -262,6 +383,205 @@ fn process_clip(clip: &bandai::SourceClip, split: Split) -> Result<Vec<Item>> {
         }
     }
     Ok(items)
+}
+
+/// A clip whose lowest joint dips further than this below where it usually is (metres) has a
+/// capture error: features put the floor at the lowest point of the whole clip, so the body
+/// would float that high for the rest of it. (HDM05's `HDM_dg_lieDownFloor_014` sends a knee
+/// 0.21 m through the floor for a moment.)
+pub const MAX_FLOOR_DIP_M: f64 = 0.1;
+
+/// How far the lowest joint of the lowest frame is below the 10th percentile of every
+/// frame's lowest joint, metres: near zero for clean captures, whatever the action (a jump's
+/// flight raises frames, it does not lower them).
+pub fn floor_dip(poses: &[Pose]) -> f64 {
+    let mut lows: Vec<f64> = poses
+        .iter()
+        .map(|p| p.iter().map(|v| v[1]).fold(f64::INFINITY, f64::min))
+        .collect();
+    if lows.is_empty() {
+        return 0.0;
+    }
+    lows.sort_by(f64::total_cmp);
+    lows[lows.len() / 10] - lows[0]
+}
+
+/// Up to `n` of `items` spread evenly over the list, so a small build still sees many labels.
+pub(crate) fn spread<T>(items: Vec<T>, n: usize) -> Vec<T> {
+    if n >= items.len() {
+        return items;
+    }
+    let step = items.len() as f64 / n as f64;
+    let wanted: Vec<usize> = (0..n).map(|i| (i as f64 * step) as usize).collect();
+    items
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| wanted.binary_search(i).is_ok())
+        .map(|(_, c)| c)
+        .collect()
+}
+
+/// Reads every source the options name, with each clip's label and split.
+fn read_sources(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Result<Vec<Clip>> {
+    let mut clips = Vec::new();
+    if let Some(path) = &options.bandai {
+        progress(&format!("reading Bandai-Namco from {}", path.display()));
+        let selection = options
+            .limit
+            .map_or(bandai::Selection::All, bandai::Selection::Spread);
+        let source = bandai::read_clips(path, &selection)?;
+        let splits = assign_splits(&source);
+        clips.extend(source.into_iter().map(|c| Clip {
+            source: Source::Bandai,
+            split: splits[&c.stem],
+            actor: format!("bandai-namco-{}", c.dataset),
+            reading: labels::bandai(&c.content),
+            stem: c.stem,
+            style: c.style,
+            motion: ClipMotion::Bvh(c.bvh),
+        }));
+    }
+    type Reader = fn(&Path) -> Result<Vec<mocap::Take>>;
+    type Labeller = fn(&str) -> Option<labels::Reading>;
+    let readers: [(&Option<PathBuf>, Reader, Labeller, &str); 3] = [
+        (
+            &options.hdm05,
+            mocap::asf_amc::read_hdm05,
+            labels::hdm05,
+            "HDM05",
+        ),
+        (
+            &options.cmu,
+            mocap::cmu_expmap::read_cmu,
+            labels::cmu,
+            "CMU",
+        ),
+        (
+            &options.deepmimic,
+            mocap::deepmimic::read_deepmimic,
+            labels::deepmimic,
+            "DeepMimic",
+        ),
+    ];
+    for (path, read, label, name) in readers {
+        let Some(path) = path else { continue };
+        progress(&format!("reading {name} from {}", path.display()));
+        let takes =
+            read(path).with_context(|| format!("reading {name} from {}", path.display()))?;
+        let mut takes = chain_short_takes(takes);
+        if let Some(n) = options.limit {
+            takes = spread(takes, n);
+        }
+        for take in takes {
+            let reading = label(&take.label).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{name} clip {} has the label '{}', which the dataset has no words for",
+                    take.stem,
+                    take.label
+                )
+            })?;
+            let source = Source::from(take.source);
+            let source_test = mocap::cmu_expmap::source_split_is_test(&take.stem);
+            let split = source
+                .split(&take.actor, source_test)
+                .unwrap_or(Split::Train);
+            clips.push(Clip {
+                source,
+                split,
+                reading,
+                style: "normal".into(),
+                stem: take.stem,
+                actor: take.actor,
+                motion: ClipMotion::Poses(take.poses),
+            });
+        }
+    }
+    if clips.is_empty() {
+        anyhow::bail!(
+            "no source given: name at least one of --bandai, --hdm05, --cmu, --deepmimic"
+        );
+    }
+    train_every_label(&mut clips);
+    Ok(clips)
+}
+
+/// Clips with fewer joint frames than this are too short to train on alone ([`MIN_FRAMES`]
+/// feature rows) and are joined with the clips cut right after them from the same take,
+/// where there are such. Longer one-repetition clips (a squat, a kick) stay single, so their
+/// captions ("does a squat") stay true.
+pub const CHAIN_FRAMES: usize = MIN_FRAMES + 1;
+
+/// Mean joint distance, metres, under which the last pose of one clip and the first of the
+/// next count as one continuous take cut in two: HDM05's one-repetition cuts of a take meet
+/// within a few centimetres (the cut falls between two 120 Hz frames), while clips from
+/// different takes start metres apart.
+pub const CONTINUOUS_GAP_M: f64 = 0.1;
+
+/// Joins each clip shorter than [`CHAIN_FRAMES`] with the following clips of the same actor
+/// and label that continue it (see [`CONTINUOUS_GAP_M`]), until the chain is long enough, and
+/// a short clip with the chain before it that it continues.
+/// HDM05 cut one hop or one arm circle per clip (0.5–1 s): alone they are too short to train
+/// on, and joined they are the repeated action as it was captured. The chain keeps the first
+/// clip's stem with the last clip's number appended (`HDM_bd_hopBothLegs1hops_001-003`).
+/// `takes` are in stem order, which is capture order within a class.
+pub fn chain_short_takes(takes: Vec<mocap::Take>) -> Vec<mocap::Take> {
+    let continues = |a: &mocap::Take, b: &mocap::Take| {
+        a.actor == b.actor
+            && a.label == b.label
+            && match (a.poses.last(), b.poses.first()) {
+                (Some(end), Some(start)) => {
+                    let gap = end
+                        .iter()
+                        .zip(start)
+                        .map(|(p, q)| geom::dist(*p, *q))
+                        .sum::<f64>()
+                        / end.len() as f64;
+                    gap < CONTINUOUS_GAP_M
+                }
+                _ => false,
+            }
+    };
+    let mut out: Vec<mocap::Take> = Vec::with_capacity(takes.len());
+    let mut chained_last: Option<String> = None;
+    for take in takes {
+        // A short clip also joins a chain it continues, rather than be left out alone.
+        let extend = out.last().is_some_and(|prev: &mocap::Take| {
+            (prev.poses.len() < CHAIN_FRAMES || take.poses.len() < CHAIN_FRAMES)
+                && continues(prev, &take)
+        });
+        if extend {
+            let prev = out.last_mut().expect("checked above");
+            prev.poses.extend(take.poses);
+            let number = take
+                .stem
+                .rsplit('_')
+                .next()
+                .unwrap_or(&take.stem)
+                .to_string();
+            let first = chained_last.take().unwrap_or_else(|| prev.stem.clone());
+            prev.stem = format!("{first}-{number}");
+            chained_last = Some(first);
+        } else {
+            chained_last = None;
+            out.push(take);
+        }
+    }
+    out
+}
+
+/// A label whose every clip of a source went to test or validation could not be learned at
+/// all (CMU's only window-washing take is in its test split): those clips train instead.
+fn train_every_label(clips: &mut [Clip]) {
+    let trained: BTreeSet<(Source, String)> = clips
+        .iter()
+        .filter(|c| c.split == Split::Train)
+        .map(|c| (c.source, c.reading.content.clone()))
+        .collect();
+    for clip in clips.iter_mut() {
+        if !trained.contains(&(clip.source, clip.reading.content.clone())) {
+            clip.split = Split::Train;
+        }
+    }
 }
 
 /// A HumanML3D text line: the caption, its tokens, and the whole-motion time span.
@@ -307,17 +627,12 @@ fn write_item(dir: &Path, item: &Item) -> Result<()> {
 /// replaced only when the build has finished.
 pub fn build(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Result<DatasetSummary> {
     let started = Instant::now();
-    progress(&format!("reading {}", options.source.display()));
-    let selection = options
-        .limit
-        .map_or(bandai::Selection::All, bandai::Selection::Spread);
-    let clips = bandai::read_clips(&options.source, &selection)?;
+    let clips = read_sources(options, progress)?;
     progress(&format!(
         "read {} clips in {:.1} s",
         clips.len(),
         started.elapsed().as_secs_f64()
     ));
-    let splits = assign_splits(&clips);
 
     let partial = options.out.with_extension("partial");
     if partial.exists() {
@@ -335,8 +650,8 @@ pub fn build(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Result
     let results: Vec<Result<(Vec<ItemRecord>, FeatureStats)>> = clips
         .par_iter()
         .map(|clip| {
-            let split = splits[&clip.stem];
-            let items = process_clip(clip, split)?;
+            let split = clip.split;
+            let items = process_clip(clip)?;
             let mut stats = FeatureStats::default();
             for item in &items {
                 write_item(&partial, item)?;
@@ -379,7 +694,11 @@ pub fn build(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Result
             .collect();
         std::fs::write(partial.join(split.file_name()), names.join("\n") + "\n")?;
     }
-    let summary = summarise(clips.len(), skipped, records);
+    let mut read: BTreeMap<Source, usize> = BTreeMap::new();
+    for clip in &clips {
+        *read.entry(clip.source).or_default() += 1;
+    }
+    let summary = summarise(&read, skipped, records);
     std::fs::write(
         partial.join("dataset.json"),
         serde_json::to_string_pretty(&summary)?,
@@ -396,10 +715,34 @@ pub fn build(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Result
 }
 
 fn summarise(
-    source_clips: usize,
+    read: &BTreeMap<Source, usize>,
     skipped_clips: Vec<String>,
     items: Vec<ItemRecord>,
 ) -> DatasetSummary {
+    let mut sources: BTreeMap<Source, SourceSummary> = read
+        .iter()
+        .map(|(s, n)| {
+            let summary = SourceSummary {
+                licence: s.licence().into(),
+                attribution: s.attribution().into(),
+                source_clips: *n,
+                items: BTreeMap::new(),
+                frames: 0,
+                actions: BTreeMap::new(),
+            };
+            (*s, summary)
+        })
+        .collect();
+    for r in &items {
+        if let Some(s) = sources.get_mut(&r.source) {
+            *s.items.entry(r.split).or_default() += 1;
+            *s.actions.entry(r.content.clone()).or_default() += 1;
+            s.frames += r.frames;
+        }
+    }
+    let join = |f: fn(Source) -> &'static str, sep: &str| {
+        read.keys().map(|s| f(*s)).collect::<Vec<_>>().join(sep)
+    };
     let frames: usize = items.iter().map(|r| r.frames).sum();
     let mut clips_per_split = BTreeMap::new();
     let mut actions = BTreeMap::new();
@@ -424,13 +767,14 @@ fn summarise(
         }
     }
     DatasetSummary {
-        name: "bandai-namco-humanml3d".into(),
-        licence: LICENCE.into(),
-        attribution: ATTRIBUTION.into(),
+        name: "coma-motions".into(),
+        licence: join(Source::licence, "; "),
+        attribution: join(Source::attribution, " "),
+        sources,
         fps: FPS,
         feature_dim: features::FEATURE_DIM,
         max_frames: MAX_FRAMES,
-        source_clips,
+        source_clips: read.values().sum(),
         skipped_clips,
         clips: items.len(),
         clips_per_split,
@@ -472,5 +816,59 @@ mod tests {
         assert_eq!(fields[0], "a person waves the left hand");
         assert_eq!(fields[1].split(' ').count(), 6);
         assert!(fields[1].starts_with("a/OTHER person/OTHER"));
+    }
+
+    fn take(stem: &str, actor: &str, frames: usize, from_x: f64) -> mocap::Take {
+        mocap::Take {
+            source: mocap::Source::Hdm05,
+            stem: stem.into(),
+            actor: actor.into(),
+            label: "hopBothLegs1hops".into(),
+            poses: (0..frames)
+                .map(|t| [[from_x + 0.01 * t as f64, 0.9, 0.0]; 22])
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn short_clips_join_the_clips_that_continue_them() {
+        let takes = vec![
+            // 001 → 002 → 003 continue each other: 001 and 002 are too short alone, 003 would
+            // be left alone too short; 004 does not continue once the chain is long enough.
+            take("HDM_bd_hop_001", "bd", 10, 0.0),
+            take("HDM_bd_hop_002", "bd", 10, 0.10),
+            take("HDM_bd_hop_003", "bd", 10, 0.20),
+            take("HDM_bd_hop_004", "bd", 25, 0.30),
+            // Starts metres away: another take.
+            take("HDM_bd_hop_005", "bd", 10, 3.0),
+            // Another actor never joins.
+            take("HDM_bk_hop_006", "bk", 10, 3.10),
+        ];
+        let chained = chain_short_takes(takes);
+        let stems: Vec<&str> = chained.iter().map(|t| t.stem.as_str()).collect();
+        assert_eq!(
+            stems,
+            [
+                "HDM_bd_hop_001-003",
+                "HDM_bd_hop_004",
+                "HDM_bd_hop_005",
+                "HDM_bk_hop_006"
+            ]
+        );
+        assert_eq!(chained[0].poses.len(), 30);
+        assert_eq!(chained[1].poses.len(), 25);
+    }
+
+    #[test]
+    fn a_knee_through_the_floor_is_a_dip_and_a_jump_is_not() {
+        let standing = |lift: f64| [[0.0, 0.05 + lift, 0.0]; 22];
+        let mut jump: Vec<Pose> = (0..40).map(|_| standing(0.0)).collect();
+        for pose in &mut jump[15..25] {
+            *pose = standing(0.3);
+        }
+        assert!(floor_dip(&jump).abs() < 1e-9);
+        let mut broken = jump.clone();
+        broken[30][4][1] = -0.16;
+        assert!((floor_dip(&broken) - 0.21).abs() < 1e-9);
     }
 }

@@ -24,6 +24,9 @@ pub struct MotionItem {
     /// The action it shows ("bow", "walk-turn-left"), where `dataset.json` names it:
     /// training can balance rare actions against frequent ones by it.
     pub content: Option<String>,
+    /// The motion capture source it comes from (`bandai`, `hdm05`, `cmu`, `deepmimic`), where
+    /// `dataset.json` names it: measurements are reported per source.
+    pub source: Option<String>,
 }
 
 /// A loaded split.
@@ -32,24 +35,31 @@ pub struct MotionSet {
     pub items: Vec<MotionItem>,
     /// The dataset's Mean/Std (of its training split).
     pub normalizer: Normalizer,
+    /// Running sums of the items' draw weights when crops are balanced by action
+    /// ([`MotionSet::balance`]); empty draws in proportion to length alone.
+    cumulative: Vec<f64>,
 }
 
-/// Item name → content label, from `<dir>/dataset.json` (our builder writes one; a dataset
-/// in the plain HumanML3D layout has none, and its items go unlabelled).
-fn content_labels(dir: &Path) -> HashMap<String, String> {
+/// What `dataset.json` says of one item.
+#[derive(serde::Deserialize)]
+struct Labelled {
+    name: String,
+    content: String,
+    /// Absent in datasets built before there was more than one source.
+    source: Option<String>,
+}
+
+/// Item name → its labels, from `<dir>/dataset.json` (our builder writes one; a dataset in the
+/// plain HumanML3D layout has none, and its items go unlabelled).
+fn item_labels(dir: &Path) -> HashMap<String, Labelled> {
     #[derive(serde::Deserialize)]
     struct Summary {
         items: Vec<Labelled>,
     }
-    #[derive(serde::Deserialize)]
-    struct Labelled {
-        name: String,
-        content: String,
-    }
     std::fs::read(dir.join("dataset.json"))
         .ok()
         .and_then(|bytes| serde_json::from_slice::<Summary>(&bytes).ok())
-        .map(|s| s.items.into_iter().map(|i| (i.name, i.content)).collect())
+        .map(|s| s.items.into_iter().map(|i| (i.name.clone(), i)).collect())
         .unwrap_or_default()
 }
 
@@ -75,7 +85,7 @@ impl MotionSet {
             .with_context(|| format!("{} has no usable Mean.npy/Std.npy", dir.display()))?;
         let list = std::fs::read_to_string(dir.join(split.file_name()))
             .with_context(|| format!("cannot read {}", dir.join(split.file_name()).display()))?;
-        let contents = content_labels(dir);
+        let labels = item_labels(dir);
         let mut items = Vec::new();
         for name in list.lines().map(str::trim).filter(|l| !l.is_empty()) {
             let path = dir.join("new_joint_vecs").join(format!("{name}.npy"));
@@ -104,13 +114,85 @@ impl MotionSet {
                 features: normalizer.normalize(&raw),
                 captions,
                 parts,
-                content: contents.get(name).cloned(),
+                content: labels.get(name).map(|l| l.content.clone()),
+                source: labels.get(name).and_then(|l| l.source.clone()),
             });
         }
         if items.is_empty() {
             bail!("{} lists no items", dir.join(split.file_name()).display());
         }
-        Ok(MotionSet { items, normalizer })
+        Ok(MotionSet {
+            items,
+            normalizer,
+            cumulative: Vec::new(),
+        })
+    }
+
+    /// Draws crops from an item in proportion to its length times `n^-balance`, where `n` is
+    /// the number of frames of its action: 0 is plain length-proportional drawing, 1 gives
+    /// every action the same share of crops however few frames it has. Unlabelled items count
+    /// as one action.
+    pub fn balance(&mut self, balance: f64) {
+        if balance == 0.0 {
+            self.cumulative.clear();
+            return;
+        }
+        let mut frames: HashMap<Option<&str>, usize> = HashMap::new();
+        for item in &self.items {
+            *frames.entry(item.content.as_deref()).or_default() += item.features.len();
+        }
+        let mut sum = 0.0;
+        self.cumulative = self
+            .items
+            .iter()
+            .map(|item| {
+                let n = frames[&item.content.as_deref()] as f64;
+                sum += item.features.len() as f64 * n.powf(-balance);
+                sum
+            })
+            .collect();
+    }
+
+    /// The share of crops each action gets under the current drawing (unlabelled items under
+    /// `"(unlabelled)"`), for the training log.
+    pub fn action_shares(&self) -> BTreeMap<String, f64> {
+        let mut shares: BTreeMap<String, f64> = BTreeMap::new();
+        let mut previous = 0.0;
+        for (i, item) in self.items.iter().enumerate() {
+            let weight = match self.cumulative.get(i) {
+                Some(c) => {
+                    let w = c - previous;
+                    previous = *c;
+                    w
+                }
+                None => item.features.len() as f64,
+            };
+            let label = item.content.as_deref().unwrap_or("(unlabelled)");
+            *shares.entry(label.to_string()).or_default() += weight;
+        }
+        let total: f64 = shares.values().sum();
+        shares
+            .values_mut()
+            .for_each(|v| *v /= total.max(f64::MIN_POSITIVE));
+        shares
+    }
+
+    /// The items `keep` accepts, with the same normalisation (and plain length-proportional
+    /// drawing).
+    pub fn subset(&self, keep: impl Fn(&MotionItem) -> bool) -> MotionSet {
+        MotionSet {
+            items: self.items.iter().filter(|i| keep(i)).cloned().collect(),
+            normalizer: self.normalizer.clone(),
+            cumulative: Vec::new(),
+        }
+    }
+
+    /// The sources named in the set, sorted (empty when `dataset.json` names none).
+    pub fn sources(&self) -> Vec<String> {
+        let mut sources: Vec<String> = self.items.iter().filter_map(|i| i.source.clone()).collect();
+        sources.sort();
+        sources.dedup();
+        sources
     }
 
     /// Total frames over all items.
@@ -118,8 +200,16 @@ impl MotionSet {
         self.items.iter().map(|i| i.features.len()).sum()
     }
 
-    /// An item index drawn with probability proportional to its length.
+    /// An item index drawn with probability proportional to its length, or to its balanced
+    /// weight ([`MotionSet::balance`]).
     fn weighted_item(&self, rng: &mut Rng, total: usize) -> usize {
+        if let Some(&sum) = self.cumulative.last() {
+            let x = rng.uniform() as f64 * sum;
+            return self
+                .cumulative
+                .partition_point(|&c| c <= x)
+                .min(self.items.len() - 1);
+        }
         let mut x = rng.below(total);
         for (i, item) in self.items.iter().enumerate() {
             if x < item.features.len() {
@@ -165,5 +255,52 @@ impl MotionSet {
             data,
             sources,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn item(content: &str, frames: usize) -> MotionItem {
+        MotionItem {
+            name: format!("{content}_{frames}"),
+            features: vec![[0.0; FEATURE_DIM]; frames],
+            captions: Vec::new(),
+            parts: BTreeMap::new(),
+            content: Some(content.to_string()),
+            source: None,
+        }
+    }
+
+    fn set() -> MotionSet {
+        let mut items: Vec<MotionItem> = (0..9).map(|_| item("walk", 100)).collect();
+        items.push(item("squat", 100));
+        MotionSet {
+            items,
+            normalizer: Normalizer {
+                mean: vec![0.0; FEATURE_DIM],
+                std: vec![1.0; FEATURE_DIM],
+            },
+            cumulative: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn balancing_raises_the_share_of_rare_actions() {
+        let mut set = set();
+        let plain = set.action_shares();
+        assert!((plain["squat"] - 0.1).abs() < 1e-9, "{plain:?}");
+        set.balance(1.0);
+        let even = set.action_shares();
+        assert!((even["squat"] - 0.5).abs() < 1e-9, "{even:?}");
+        // The draws follow the shares.
+        let mut rng = Rng::new(5);
+        let squats = (0..4000)
+            .filter(|_| set.weighted_item(&mut rng, set.frames()) == 9)
+            .count();
+        assert!((1800..2200).contains(&squats), "{squats} of 4000");
+        set.balance(0.0);
+        assert_eq!(set.action_shares(), plain);
     }
 }

@@ -4,8 +4,11 @@
 //!   (right) wrist higher than the other;
 //! - edit locality: editing one arm of a motion must leave the legs where they were;
 //! - continuity: the join of two blended segments must not be faster than real motion ever is;
+//! - left/right for legs: kicking with the left (right) foot must lift the left (right) ankle
+//!   higher than the other;
 //! - actions: "a person bows" must bend the trunk forward about as far as the dataset's bows
-//!   do, "a person waves the left hand" must move that hand about as much as its waves do.
+//!   do, "a person waves the left hand" must move that hand about as much as its waves do, and
+//!   squats, jumps, lying down, kicks and throws likewise by one measure each ([`ACTIONS`]).
 
 use crate::dataset::motions::MotionSet;
 use crate::executor::block_on;
@@ -26,44 +29,51 @@ pub struct LeftRightReport {
     pub rate: f64,
 }
 
-/// The highest the wrist gets above its own starting height, in metres.
-fn wrist_rise(poses: &[Pose], wrist: usize) -> f64 {
-    let start = poses.first().map_or(0.0, |p| p[wrist][1]);
+/// The highest a joint (a wrist, an ankle) gets above its own starting height, in metres.
+fn joint_rise(poses: &[Pose], j: usize) -> f64 {
+    let start = poses.first().map_or(0.0, |p| p[j][1]);
     poses
         .iter()
-        .map(|p| p[wrist][1] - start)
+        .map(|p| p[j][1] - start)
         .fold(f64::MIN, f64::max)
 }
 
 /// Raises and waves each hand with `seeds` seeds each; a sample is correct when the asked
 /// wrist rises more than the other one.
 pub fn left_right(model: &MotionModel, seeds: u64, seconds: f64) -> LeftRightReport {
-    let prompts = [
-        (
-            "a person raises the left hand",
-            joint::L_WRIST,
-            joint::R_WRIST,
-        ),
-        (
-            "a person raises the right hand",
-            joint::R_WRIST,
-            joint::L_WRIST,
-        ),
-        (
-            "a person waves the left hand",
-            joint::L_WRIST,
-            joint::R_WRIST,
-        ),
-        (
-            "a person waves the right hand",
-            joint::R_WRIST,
-            joint::L_WRIST,
-        ),
-    ];
+    sided_prompts(model, &ARM_PROMPTS, seeds, seconds)
+}
+
+/// Kicks with each foot with `seeds` seeds each; a sample is correct when the asked ankle
+/// rises more than the other one.
+pub fn left_right_legs(model: &MotionModel, seeds: u64, seconds: f64) -> LeftRightReport {
+    sided_prompts(model, &LEG_PROMPTS, seeds, seconds)
+}
+
+/// The legs' left/right prompts: the asked ankle, then the other.
+pub const LEG_PROMPTS: [(&str, usize, usize); 2] = [
+    (
+        "a person kicks with the left foot",
+        joint::L_ANKLE,
+        joint::R_ANKLE,
+    ),
+    (
+        "a person kicks with the right foot",
+        joint::R_ANKLE,
+        joint::L_ANKLE,
+    ),
+];
+
+fn sided_prompts(
+    model: &MotionModel,
+    prompts: &[(&str, usize, usize)],
+    seeds: u64,
+    seconds: f64,
+) -> LeftRightReport {
     let frames = (seconds * FPS) as usize;
     let mut rows = Vec::new();
     let (mut good, mut total) = (0, 0);
-    for (prompt, asked, other) in prompts {
+    for &(prompt, asked, other) in prompts {
         let correct = (0..seeds)
             .filter(|seed| {
                 let poses = block_on(async {
@@ -71,7 +81,7 @@ pub fn left_right(model: &MotionModel, seeds: u64, seconds: f64) -> LeftRightRep
                         .joints(&model.generate(prompt, &[], frames, *seed).await)
                         .await
                 });
-                wrist_rise(&poses, asked) > wrist_rise(&poses, other)
+                joint_rise(&poses, asked) > joint_rise(&poses, other)
             })
             .count();
         good += correct;
@@ -83,6 +93,30 @@ pub fn left_right(model: &MotionModel, seeds: u64, seconds: f64) -> LeftRightRep
         rate: good as f64 / total.max(1) as f64,
     }
 }
+
+/// The arms' left/right prompts: the asked wrist, then the other.
+pub const ARM_PROMPTS: [(&str, usize, usize); 4] = [
+    (
+        "a person raises the left hand",
+        joint::L_WRIST,
+        joint::R_WRIST,
+    ),
+    (
+        "a person raises the right hand",
+        joint::R_WRIST,
+        joint::L_WRIST,
+    ),
+    (
+        "a person waves the left hand",
+        joint::L_WRIST,
+        joint::R_WRIST,
+    ),
+    (
+        "a person waves the right hand",
+        joint::R_WRIST,
+        joint::L_WRIST,
+    ),
+];
 
 /// The motion the edit-locality probe edits.
 pub const LOCALITY_BASE: &str = "a person walks forward";
@@ -176,7 +210,7 @@ fn edit_locality_sample(
     LocalitySample {
         seed,
         leg_change_cm: total / count.max(1) as f64 * 100.0,
-        left_wrist_rise_gain_cm: (wrist_rise(&b, joint::L_WRIST) - wrist_rise(&a, joint::L_WRIST))
+        left_wrist_rise_gain_cm: (joint_rise(&b, joint::L_WRIST) - joint_rise(&a, joint::L_WRIST))
             * 100.0,
     }
 }
@@ -265,9 +299,11 @@ pub fn left_wrist_speed(poses: &[Pose]) -> f64 {
 /// An action of the dataset, the prompt asking for it, and one number saying how much of it a
 /// motion performs, so generated motions can be held against the dataset's own performances.
 pub struct ActionProbe {
+    /// Short name (`coma probe action <name>`).
+    pub name: &'static str,
     pub prompt: &'static str,
-    /// The dataset's content label of the real performances (see `dataset.json`).
-    pub content: &'static str,
+    /// The dataset's content labels of the real performances (see `dataset.json`).
+    pub contents: &'static [&'static str],
     /// What [`ActionProbe::measure`] gives, and its unit.
     pub measure_name: &'static str,
     pub unit: &'static str,
@@ -276,8 +312,9 @@ pub struct ActionProbe {
 
 /// "A person bows", by the [`trunk_lean`] (degrees).
 pub const BOW: ActionProbe = ActionProbe {
+    name: "bow",
     prompt: "a person bows",
-    content: "bow",
+    contents: &["bow"],
     measure_name: "trunk lean",
     unit: "°",
     measure: trunk_lean,
@@ -285,18 +322,151 @@ pub const BOW: ActionProbe = ActionProbe {
 
 /// "A person waves the left hand", by the [`left_wrist_speed`] (m/s).
 pub const LEFT_WAVE: ActionProbe = ActionProbe {
+    name: "wave",
     prompt: "a person waves the left hand",
-    content: "wave-left-hand",
+    contents: &["wave-left-hand"],
     measure_name: "left-wrist speed about the pelvis",
     unit: "m/s",
     measure: left_wrist_speed,
 };
 
+/// The pelvis height of the first frames (median of the first 5), metres: where a motion
+/// starts from, robust to one odd frame.
+fn start_height(poses: &[Pose]) -> f64 {
+    quantile(
+        poses.iter().take(5).map(|p| p[joint::PELVIS][1]).collect(),
+        0.5,
+    )
+}
+
+/// How far the pelvis drops below its starting height at the lowest point, metres: a squat
+/// lowers it by about half the leg length; a walk's bob is a few centimetres.
+pub fn pelvis_drop(poses: &[Pose]) -> f64 {
+    let low = poses
+        .iter()
+        .map(|p| p[joint::PELVIS][1])
+        .fold(f64::INFINITY, f64::min);
+    if poses.is_empty() {
+        0.0
+    } else {
+        start_height(poses) - low
+    }
+}
+
+/// How far the pelvis rises above its starting height at the highest point, metres: a
+/// jump lifts it by the flight's height plus the push-off's extension.
+pub fn pelvis_rise(poses: &[Pose]) -> f64 {
+    let high = poses
+        .iter()
+        .map(|p| p[joint::PELVIS][1])
+        .fold(f64::NEG_INFINITY, f64::max);
+    if poses.is_empty() {
+        0.0
+    } else {
+        high - start_height(poses)
+    }
+}
+
+/// How much lower the pelvis is over the last half second than at the start, metres: lying
+/// down ends with it near the floor, about 0.8 m below standing.
+pub fn pelvis_lowered_at_end(poses: &[Pose]) -> f64 {
+    let tail = (FPS / 2.0) as usize;
+    let end: Vec<f64> = poses
+        .iter()
+        .rev()
+        .take(tail.max(1))
+        .map(|p| p[joint::PELVIS][1])
+        .collect();
+    if poses.is_empty() {
+        0.0
+    } else {
+        start_height(poses) - end.iter().sum::<f64>() / end.len() as f64
+    }
+}
+
+/// The highest either ankle rises above its starting height, metres: a front kick swings
+/// the foot to hip height or above; a walk's step lifts it some 15 cm.
+pub fn ankle_rise(poses: &[Pose]) -> f64 {
+    joint_rise(poses, joint::L_ANKLE).max(joint_rise(poses, joint::R_ANKLE))
+}
+
+/// The fastest either wrist moves about the pelvis in one frame, m/s: a throw whips the
+/// throwing hand well past a wave's or a walk's arm swing.
+pub fn peak_wrist_speed(poses: &[Pose]) -> f64 {
+    [joint::L_WRIST, joint::R_WRIST]
+        .iter()
+        .flat_map(|&w| {
+            poses.windows(2).map(move |p| {
+                let a = geom::sub(p[0][w], p[0][joint::PELVIS]);
+                let b = geom::sub(p[1][w], p[1][joint::PELVIS]);
+                geom::dist(a, b) * FPS
+            })
+        })
+        .fold(0.0, f64::max)
+}
+
+/// "A person does a squat", by the [`pelvis_drop`] (m).
+pub const SQUAT: ActionProbe = ActionProbe {
+    name: "squat",
+    prompt: "a person does a squat",
+    contents: &["squat"],
+    measure_name: "pelvis drop",
+    unit: " m",
+    measure: pelvis_drop,
+};
+
+/// "A person jumps with both feet", by the [`pelvis_rise`] (m).
+pub const JUMP: ActionProbe = ActionProbe {
+    name: "jump",
+    prompt: "a person jumps with both feet",
+    contents: &["jump", "jump-forward"],
+    measure_name: "pelvis rise",
+    unit: " m",
+    measure: pelvis_rise,
+};
+
+/// "A person lies down on the floor", by the [`pelvis_lowered_at_end`] (m).
+pub const LIE_DOWN: ActionProbe = ActionProbe {
+    name: "lie-down",
+    prompt: "a person lies down on the floor",
+    contents: &["lie-down"],
+    measure_name: "pelvis lowered at the end",
+    unit: " m",
+    measure: pelvis_lowered_at_end,
+};
+
+/// "A person kicks forward", by the [`ankle_rise`] (m).
+pub const KICK: ActionProbe = ActionProbe {
+    name: "kick",
+    prompt: "a person kicks forward",
+    contents: &["kick", "kick-left-leg", "kick-right-leg"],
+    measure_name: "ankle rise",
+    unit: " m",
+    measure: ankle_rise,
+};
+
+/// "A person throws a ball", by the [`peak_wrist_speed`] (m/s).
+pub const THROW: ActionProbe = ActionProbe {
+    name: "throw",
+    prompt: "a person throws a ball",
+    contents: &["throw", "throw-left-hand", "throw-right-hand"],
+    measure_name: "peak wrist speed about the pelvis",
+    unit: " m/s",
+    measure: peak_wrist_speed,
+};
+
+/// Every action probe.
+pub const ACTIONS: [&ActionProbe; 7] = [&BOW, &LEFT_WAVE, &SQUAT, &JUMP, &LIE_DOWN, &KICK, &THROW];
+
 /// The probe's measure of each motion of `set` that shows its action.
 pub fn real_performances(set: &MotionSet, probe: &ActionProbe) -> Vec<f64> {
     set.items
         .iter()
-        .filter(|i| i.content.as_deref() == Some(probe.content))
+        .filter(|i| {
+            i.content
+                .as_deref()
+                .is_some_and(|c| probe.contents.contains(&c))
+        })
         .map(|i| (probe.measure)(&set.joints(i)))
         .collect()
 }
@@ -397,6 +567,37 @@ mod tests {
     }
 
     #[test]
+    fn action_measures_read_heights_and_speeds() {
+        let stand = |h: f64| {
+            let mut p = [[0.0; 3]; 22];
+            p[joint::PELVIS][1] = h;
+            p[joint::L_ANKLE][1] = 0.08;
+            p[joint::R_ANKLE][1] = 0.08;
+            p
+        };
+        // Squat: 0.95 m down to 0.5 m and back.
+        let squat: Vec<Pose> = [0.95, 0.95, 0.95, 0.95, 0.95, 0.9, 0.7, 0.5, 0.6, 0.95]
+            .iter()
+            .map(|&h| stand(h))
+            .collect();
+        assert!((pelvis_drop(&squat) - 0.45).abs() < 1e-9);
+        assert!(pelvis_rise(&squat).abs() < 1e-9);
+        // Lying down: ends 0.15 m above the floor for the last half second.
+        let mut lie: Vec<Pose> = (0..30).map(|_| stand(0.95)).collect();
+        lie.extend((0..10).map(|_| stand(0.15)));
+        assert!((pelvis_lowered_at_end(&lie) - 0.8).abs() < 1e-9);
+        // Kick: the right ankle to 0.7 m.
+        let mut kick = squat.clone();
+        kick[7][joint::R_ANKLE][1] = 0.7;
+        assert!((ankle_rise(&kick) - 0.62).abs() < 1e-9);
+        // Throw: the right wrist moves 0.5 m in one frame: 10 m/s at 20 fps.
+        let mut throw = vec![stand(0.95); 3];
+        throw[2][joint::R_WRIST] = [0.0, 0.0, 0.5];
+        assert!((peak_wrist_speed(&throw) - 10.0).abs() < 1e-9);
+        assert_eq!(pelvis_drop(&[]), 0.0);
+    }
+
+    #[test]
     fn quantiles_and_speeds() {
         assert_eq!(quantile(vec![3.0, 1.0, 2.0], 0.0), 1.0);
         assert_eq!(quantile(vec![3.0, 1.0, 2.0], 1.0), 3.0);
@@ -440,6 +641,6 @@ mod tests {
         poses[0][joint::L_WRIST][1] = 1.0;
         poses[1][joint::L_WRIST][1] = 1.6;
         poses[2][joint::L_WRIST][1] = 1.2;
-        assert!((wrist_rise(&poses, joint::L_WRIST) - 0.6).abs() < 1e-12);
+        assert!((joint_rise(&poses, joint::L_WRIST) - 0.6).abs() < 1e-12);
     }
 }

@@ -1,5 +1,5 @@
 //! The dataset's real motions that the control probes hold generated motions against: the
-//! training performances of an action (`coma probe bow|wave`), and the test motions whose
+//! training performances of an action (`coma probe bow|wave|squat|…`), and the test motions whose
 //! frame-to-frame speeds bound how fast a blend's join may be (`coma probe continuity`,
 //! `coma eval`).
 
@@ -31,9 +31,9 @@ pub fn action_reference(data: &Path, probe: &ActionProbe) -> Result<ActionRefere
     let real = real_performances(&set, probe);
     anyhow::ensure!(
         !real.is_empty(),
-        "no training motion of {} is labelled {:?}",
+        "no training motion of {} is labelled {}",
         data.display(),
-        probe.content
+        probe.contents.join(" or ")
     );
     Ok(ActionReference {
         motions: real.len(),

@@ -104,6 +104,8 @@ fn cosine(a: &[f32], b: &[f32]) -> f64 {
 pub struct EvaluatorTrainOptions {
     pub run_dir: PathBuf,
     pub minutes: Option<f64>,
+    /// Weights a fresh run starts from (fine-tuning), instead of random ones.
+    pub init: Option<PathBuf>,
 }
 
 fn learning_rate(config: &EvaluatorTrainingConfig, step: usize) -> f64 {
@@ -152,7 +154,12 @@ pub fn train_evaluator(
     config
         .save(options.run_dir.join("config.json"))
         .map_err(|e| anyhow::anyhow!("saving config.json: {e}"))?;
-    let mut model = config.model.init(device);
+    let mut model = run.start_from(
+        config.model.init(device),
+        options.init.as_deref(),
+        resumed,
+        progress,
+    )?;
     let mut optim = AdamWConfig::new()
         .with_weight_decay(1e-4)
         .with_grad_clipping(Some(GradientClippingConfig::Norm(1.0)))
@@ -332,6 +339,7 @@ mod tests {
         let options = EvaluatorTrainOptions {
             run_dir: tmp.path().to_path_buf(),
             minutes: None,
+            init: None,
         };
         let half = EvaluatorTrainingConfig {
             steps: 30,

@@ -23,3 +23,14 @@ pub fn training_device(name: &str) -> anyhow::Result<burn::tensor::Device> {
         other => anyhow::bail!("unknown device '{other}' (flex or tch)"),
     }
 }
+
+/// Action shares as a log line, largest first: `walk 41.2 %, run 9.0 %, …`.
+pub fn format_shares(shares: &std::collections::BTreeMap<String, f64>) -> String {
+    let mut sorted: Vec<(&String, &f64)> = shares.iter().collect();
+    sorted.sort_by(|a, b| b.1.total_cmp(a.1).then(a.0.cmp(b.0)));
+    sorted
+        .iter()
+        .map(|(label, share)| format!("{label} {:.1} %", *share * 100.0))
+        .collect::<Vec<_>>()
+        .join(", ")
+}

@@ -224,6 +224,33 @@ impl Run {
         )
     }
 
+    /// A fresh run's model started from trained weights (`init`: fine-tuning on new data)
+    /// instead of random ones. A resumed run keeps its checkpoint, and says `init` is unused.
+    pub fn start_from<M: burn::store::ModuleSnapshot>(
+        &self,
+        model: M,
+        init: Option<&Path>,
+        resumed: bool,
+        progress: &dyn Fn(&str),
+    ) -> Result<M> {
+        match init {
+            None => Ok(model),
+            Some(path) if resumed => {
+                progress(&format!(
+                    "not starting from {}: the run resumes from its checkpoint",
+                    path.display()
+                ));
+                Ok(model)
+            }
+            Some(path) => {
+                let model = crate::weights::load_file(model, path)
+                    .with_context(|| format!("starting from {}", path.display()))?;
+                progress(&format!("starting from the weights in {}", path.display()));
+                Ok(model)
+            }
+        }
+    }
+
     /// Checkpoints the model and optimizer.
     pub fn save<M: burn::module::Module>(
         &mut self,

@@ -125,6 +125,24 @@ impl TokenSet {
             .collect()
     }
 
+    /// The share of draws each action gets with `weights` (uniform when `None`), unlabelled
+    /// items under `"(unlabelled)"`, for the training log.
+    pub fn action_shares(
+        &self,
+        weights: Option<&[f64]>,
+    ) -> std::collections::BTreeMap<String, f64> {
+        let mut shares = std::collections::BTreeMap::new();
+        for (i, item) in self.items.iter().enumerate() {
+            let label = item.content.as_deref().unwrap_or("(unlabelled)");
+            *shares.entry(label.to_string()).or_insert(0.0) += weights.map_or(1.0, |w| w[i]);
+        }
+        let total: f64 = shares.values().sum();
+        shares
+            .values_mut()
+            .for_each(|v| *v /= total.max(f64::MIN_POSITIVE));
+        shares
+    }
+
     /// A random batch of `draw.batch` motions of similar length (between ¾ of and the length
     /// of a randomly drawn one), drawn in proportion to `draw.weights`. Each part's condition
     /// is the motion's own sentence for that part with probability `draw.part_text`, else one

@@ -29,6 +29,10 @@ pub struct VqTrainingConfig {
     /// Longest crop in frames (at 20 fps); shorter motions train in batches of their length.
     #[config(default = 64)]
     pub max_frames: usize,
+    /// How strongly crops favour rare actions (see `MotionSet::balance`: 0 draws in
+    /// proportion to length, 1 gives every action the same share).
+    #[config(default = 0.0)]
+    pub balance: f64,
     /// Total optimizer steps.
     #[config(default = 5000)]
     pub steps: usize,
@@ -84,6 +88,8 @@ pub struct VqTrainOptions {
     pub run_dir: PathBuf,
     /// Stop after this many minutes (checkpointing first); the run resumes next time.
     pub minutes: Option<f64>,
+    /// Weights a fresh run starts from (fine-tuning), instead of random ones.
+    pub init: Option<PathBuf>,
 }
 
 /// Trains (or resumes) a VQ-VAE run, printing progress through `progress`.
@@ -93,7 +99,8 @@ pub fn train_vq(
     device: &Device,
     progress: &dyn Fn(&str),
 ) -> Result<()> {
-    let train = MotionSet::load(&options.data, Split::Train)?;
+    let mut train = MotionSet::load(&options.data, Split::Train)?;
+    train.balance(config.balance);
     // A small dataset may have no validation motions; training goes on without validation.
     let val = MotionSet::load(&options.data, Split::Val).ok();
     progress(&format!(
@@ -114,7 +121,16 @@ pub fn train_vq(
         .save(options.run_dir.join("config.json"))
         .context("saving config.json")?;
 
-    let mut model = config.model.init(device);
+    progress(&format!(
+        "share of crops per action: {}",
+        super::format_shares(&train.action_shares())
+    ));
+    let mut model = run.start_from(
+        config.model.init(device),
+        options.init.as_deref(),
+        resumed,
+        progress,
+    )?;
     let mut optim = AdamWConfig::new()
         .with_weight_decay(0.0)
         .with_grad_clipping(Some(GradientClippingConfig::Norm(1.0)))
@@ -281,4 +297,96 @@ pub fn reconstruction_errors(
         root_aligned_mm: aligned / n * 1000.0,
         motions,
     })
+}
+
+/// How predictable one residual layer's codes are, over a set of motions: entropies in nats
+/// (ln 256 = 5.55 for codes used uniformly at random), from code counts per body part.
+#[derive(Clone, Debug)]
+pub struct LayerCodeStats {
+    pub layer: usize,
+    /// H(code): how evenly the layer's codes are used.
+    pub entropy: f64,
+    /// H(code | the code of the layer below at the same step and part): what the layer
+    /// below leaves unexplained. Near `entropy` means the layers are independent.
+    pub given_previous: f64,
+    /// H(code | the layer-0 code at the same step and part).
+    pub given_first: f64,
+    /// Distinct codes used.
+    pub used: usize,
+}
+
+/// Entropy in nats of the counts' distribution.
+fn entropy(counts: impl Iterator<Item = usize>) -> f64 {
+    let counts: Vec<f64> = counts.filter(|&c| c > 0).map(|c| c as f64).collect();
+    let total: f64 = counts.iter().sum();
+    counts.iter().map(|c| -(c / total) * (c / total).ln()).sum()
+}
+
+/// H(B | A) in nats from counts of the pairs `(a, b)`: H(A, B) − H(A).
+fn conditional_entropy(pairs: &std::collections::HashMap<(u32, u32), usize>) -> f64 {
+    let mut first: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    for ((a, _), n) in pairs {
+        *first.entry(*a).or_default() += n;
+    }
+    entropy(pairs.values().copied()) - entropy(first.values().copied())
+}
+
+/// Code statistics of every residual layer over up to `limit` motions of `set`, pooled over
+/// the four body parts (each part's pairs kept apart). Conditional entropies from counts are
+/// biased low when codes outnumber the samples per code: compare layers with each other, not
+/// with ln 256.
+pub fn code_statistics(
+    model: &MotionVq,
+    set: &MotionSet,
+    device: &Device,
+    limit: usize,
+) -> Vec<LayerCodeStats> {
+    use std::collections::HashMap;
+    let mut single: Vec<HashMap<(usize, u32), usize>> = Vec::new();
+    let mut previous: Vec<HashMap<(u32, u32), usize>> = Vec::new();
+    let mut from_first: Vec<HashMap<(u32, u32), usize>> = Vec::new();
+    for item in set.items.iter().take(limit) {
+        let tokens = model.tokenize_motion(&item.features, device);
+        for (part, layers) in tokens.iter().enumerate() {
+            if single.len() < layers.len() {
+                single.resize_with(layers.len(), HashMap::new);
+                previous.resize_with(layers.len(), HashMap::new);
+                from_first.resize_with(layers.len(), HashMap::new);
+            }
+            // Part-specific keys: codes of different parts are different symbols.
+            let key = |c: u32| c + (part as u32) * 1_000_000;
+            for (l, codes) in layers.iter().enumerate() {
+                for (s, &c) in codes.iter().enumerate() {
+                    *single[l].entry((part, c)).or_default() += 1;
+                    if l > 0 {
+                        *previous[l].entry((key(layers[l - 1][s]), c)).or_default() += 1;
+                        *from_first[l].entry((key(layers[0][s]), c)).or_default() += 1;
+                    }
+                }
+            }
+        }
+    }
+    let parts = 4.0f64;
+    (0..single.len())
+        .map(|l| {
+            // Pooled over parts: subtract the part's own entropy (ln 4 when parts are equally
+            // represented, which they are: every motion has all four).
+            let h = entropy(single[l].values().copied()) - parts.ln();
+            LayerCodeStats {
+                layer: l,
+                entropy: h,
+                given_previous: if l > 0 {
+                    conditional_entropy(&previous[l])
+                } else {
+                    h
+                },
+                given_first: if l > 0 {
+                    conditional_entropy(&from_first[l])
+                } else {
+                    h
+                },
+                used: single[l].len(),
+            }
+        })
+        .collect()
 }

@@ -153,6 +153,10 @@ pub struct RunArgs {
     /// Override the total number of steps.
     #[arg(long)]
     pub steps: Option<usize>,
+    /// Start a fresh run from these trained weights (fine-tuning on new data) instead of
+    /// random ones; a run that resumes from its checkpoint ignores it.
+    #[arg(long)]
+    pub init: Option<PathBuf>,
     /// Training backend: flex (pure Rust) or tch (libtorch; needs the `tch` feature).
     #[arg(long, default_value = "flex")]
     pub device: String,

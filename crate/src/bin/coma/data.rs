@@ -12,15 +12,29 @@ pub struct DataArgs {
 
 #[derive(Subcommand)]
 enum DataCommand {
-    /// Convert the Bandai-Namco archive into a HumanML3D-layout dataset.
+    /// Convert motion capture sources into one HumanML3D-layout dataset (each source
+    /// optional, at least one).
     Build {
+        /// The shared data folder: takes every source below from its usual place in it
+        /// (a source named on its own overrides it).
+        #[arg(long)]
+        shared: Option<PathBuf>,
         /// bandai-namco-bvh.tar.xz, or the folder it was extracted into.
         #[arg(long)]
-        bandai: PathBuf,
+        bandai: Option<PathBuf>,
+        /// hdm05-subset-amc.tar.xz, or the folder it was extracted into.
+        #[arg(long)]
+        hdm05: Option<PathBuf>,
+        /// cmu-8action-expmap.tar.xz, or the folder it was extracted into.
+        #[arg(long)]
+        cmu: Option<PathBuf>,
+        /// The deepmimic folder (humanoid3d.txt and motions/).
+        #[arg(long)]
+        deepmimic: Option<PathBuf>,
         /// Output folder.
         #[arg(long)]
         out: PathBuf,
-        /// Use only this many clips, spread over the set (quick builds).
+        /// Use only this many clips of each source, spread over it (quick builds).
         #[arg(long)]
         limit: Option<usize>,
     },
@@ -28,9 +42,28 @@ enum DataCommand {
 
 pub fn run(args: DataArgs) -> Result<()> {
     match args.command {
-        DataCommand::Build { bandai, out, limit } => {
+        DataCommand::Build {
+            shared,
+            bandai,
+            hdm05,
+            cmu,
+            deepmimic,
+            out,
+            limit,
+        } => {
+            let usual = |given: Option<PathBuf>, place: &str| {
+                given.or_else(|| {
+                    shared
+                        .as_ref()
+                        .map(|s| s.join(place))
+                        .filter(|p| p.exists())
+                })
+            };
             let options = coma::dataset::BuildOptions {
-                source: bandai,
+                bandai: usual(bandai, "bandai-namco-bvh.tar.xz"),
+                hdm05: usual(hdm05, "hdm05-subset/hdm05-subset-amc.tar.xz"),
+                cmu: usual(cmu, "cmu-8action-expmap/cmu-8action-expmap.tar.xz"),
+                deepmimic: usual(deepmimic, "deepmimic"),
                 out: out.clone(),
                 limit,
             };
@@ -45,6 +78,12 @@ pub fn run(args: DataArgs) -> Result<()> {
                 summary.captions,
                 summary.clips_per_split
             );
+            for (source, s) in &summary.sources {
+                println!(
+                    "  {source:?}: {} source clips, items per split {:?}, {} frames; {}",
+                    s.source_clips, s.items, s.frames, s.licence
+                );
+            }
         }
     }
     Ok(())

@@ -3,7 +3,9 @@
 use crate::common::{load_model, ModelArgs};
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use coma::eval::probes::{action, edit_locality, left_right, quantile, ActionProbe};
+use coma::eval::probes::{
+    action, edit_locality, left_right, left_right_legs, quantile, ActionProbe,
+};
 use coma::eval::probes::{LOCALITY_BASE, LOCALITY_EDIT};
 use coma::model::MotionModel;
 use std::path::PathBuf;
@@ -14,7 +16,7 @@ pub struct ProbeArgs {
     command: ProbeCommand,
 }
 
-/// Options of the action probes (`coma probe bow`, `coma probe wave`).
+/// Options of the action probes (`coma probe bow`, `coma probe squat`, …).
 #[derive(Args)]
 struct ActionArgs {
     #[arg(long, default_value_t = 20)]
@@ -40,10 +42,14 @@ struct ActionArgs {
 
 #[derive(Subcommand)]
 enum ProbeCommand {
-    /// Raise and wave each hand over many seeds: how often the asked wrist ends higher.
+    /// Raise and wave each hand over many seeds: how often the asked wrist ends higher (with
+    /// `--legs`: kick with each foot, how often the asked ankle rises higher).
     Leftright {
         #[arg(long, default_value_t = 20)]
         seeds: u64,
+        /// Probe the legs (kicks) instead of the arms.
+        #[arg(long)]
+        legs: bool,
         #[command(flatten)]
         model: ModelArgs,
     },
@@ -59,6 +65,17 @@ enum ProbeCommand {
     /// "A person waves the left hand" over many seeds: how fast the left wrist moves, against
     /// the dataset's left-hand waves.
     Wave(ActionArgs),
+    /// "A person does a squat": how far the pelvis drops, against the dataset's squats.
+    Squat(ActionArgs),
+    /// "A person jumps with both feet": how high the pelvis rises, against the dataset's jumps.
+    Jump(ActionArgs),
+    /// "A person lies down on the floor": how much lower the pelvis ends, against the
+    /// dataset's lying down.
+    LieDown(ActionArgs),
+    /// "A person kicks forward": how high an ankle rises, against the dataset's kicks.
+    Kick(ActionArgs),
+    /// "A person throws a ball": the fastest wrist speed, against the dataset's throws.
+    Throw(ActionArgs),
     /// Blend two segments: speeds at the join against real motion's 99th percentile.
     Continuity {
         /// Dataset whose test motions give the reference speeds.
@@ -79,12 +96,21 @@ pub fn run(args: ProbeArgs) -> Result<()> {
         | ProbeCommand::Locality { model, .. }
         | ProbeCommand::Bow(ActionArgs { model, .. })
         | ProbeCommand::Wave(ActionArgs { model, .. })
+        | ProbeCommand::Squat(ActionArgs { model, .. })
+        | ProbeCommand::Jump(ActionArgs { model, .. })
+        | ProbeCommand::LieDown(ActionArgs { model, .. })
+        | ProbeCommand::Kick(ActionArgs { model, .. })
+        | ProbeCommand::Throw(ActionArgs { model, .. })
         | ProbeCommand::Continuity { model, .. } => model.models.clone(),
     };
     let generator = load_model(&models)?;
     match command {
-        ProbeCommand::Leftright { seeds, .. } => {
-            let report = left_right(&generator, seeds, 4.0);
+        ProbeCommand::Leftright { seeds, legs, .. } => {
+            let report = if legs {
+                left_right_legs(&generator, seeds, 4.0)
+            } else {
+                left_right(&generator, seeds, 4.0)
+            };
             for (prompt, good, total) in &report.prompts {
                 println!("{prompt:<34} {good}/{total}");
             }
@@ -109,6 +135,13 @@ pub fn run(args: ProbeArgs) -> Result<()> {
         }
         ProbeCommand::Bow(args) => action_probe(&generator, &coma::eval::probes::BOW, args)?,
         ProbeCommand::Wave(args) => action_probe(&generator, &coma::eval::probes::LEFT_WAVE, args)?,
+        ProbeCommand::Squat(args) => action_probe(&generator, &coma::eval::probes::SQUAT, args)?,
+        ProbeCommand::Jump(args) => action_probe(&generator, &coma::eval::probes::JUMP, args)?,
+        ProbeCommand::LieDown(args) => {
+            action_probe(&generator, &coma::eval::probes::LIE_DOWN, args)?
+        }
+        ProbeCommand::Kick(args) => action_probe(&generator, &coma::eval::probes::KICK, args)?,
+        ProbeCommand::Throw(args) => action_probe(&generator, &coma::eval::probes::THROW, args)?,
         ProbeCommand::Continuity { data, seed, .. } => {
             let set = coma::dataset::motions::MotionSet::load(&data, coma::dataset::Split::Test)?;
             let r = coma::eval::references::walk_to_bow(&generator, &set, seed);
@@ -138,7 +171,9 @@ fn action_probe(generator: &MotionModel, probe: &ActionProbe, args: ActionArgs) 
     let p10 = real.p10;
     println!(
         "real {} ({} training motions): {name} median {:.2}{unit}, 10th percentile {p10:.2}{unit}",
-        probe.content, real.motions, real.median
+        probe.contents.join("/"),
+        real.motions,
+        real.median
     );
     let options = coma::model::generate::SamplingOptions {
         top_k: args.top_k,

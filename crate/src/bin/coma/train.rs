@@ -64,6 +64,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
                 data: args.data,
                 run_dir: run,
                 minutes: args.minutes,
+                init: args.init.clone(),
             };
             train_vq(&cfg, &options, &device, &print)?;
         }
@@ -80,6 +81,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
             let options = EvaluatorTrainOptions {
                 run_dir: run,
                 minutes: args.minutes,
+                init: args.init.clone(),
             };
             coma::train::launch::train_evaluator_on_dataset(
                 &cfg,
@@ -124,6 +126,7 @@ fn train_transformer(kind: Kind, args: TransformerArgs) -> Result<()> {
     let options = TransformerTrainOptions {
         run_dir: run,
         minutes: args.run.minutes,
+        init: args.run.init.clone(),
     };
     train_transformer_on_dataset(kind, &cfg, &sources, &options, &args.run.device, &|l| {
         println!("{l}")

@@ -23,6 +23,9 @@ pub struct VqErrorArgs {
     /// Decode from the first N residual layers only (default: all).
     #[arg(long)]
     layers: Option<usize>,
+    /// Also print how predictable each residual layer's codes are (entropies in nats).
+    #[arg(long)]
+    codes: bool,
 }
 
 pub fn run(args: VqErrorArgs) -> Result<()> {
@@ -44,5 +47,22 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
         "{} motions of the {:?} split, {layers} of {} layers: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned)",
         e.motions, split, cfg.model.layers, e.global_mm, e.root_aligned_mm
     );
+    for source in set.sources() {
+        let part = set.subset(|i| i.source.as_deref() == Some(source.as_str()));
+        let e = coma::train::vq::reconstruction_errors(&model, &part, &device, args.limit, layers)?;
+        println!(
+            "  {source}: {} motions, {:.1} mm (root path integrated), {:.1} mm (root aligned)",
+            e.motions, e.global_mm, e.root_aligned_mm
+        );
+    }
+    if args.codes {
+        println!("layer  used  H(code)  H(code | layer below)  H(code | layer 0)   (nats; ln 256 = 5.55)");
+        for l in coma::train::vq::code_statistics(&model, &set, &device, args.limit) {
+            println!(
+                "{:>5} {:>5} {:>8.2} {:>22.2} {:>18.2}",
+                l.layer, l.used, l.entropy, l.given_previous, l.given_first
+            );
+        }
+    }
     Ok(())
 }
