@@ -22,9 +22,27 @@ pub fn distance(a: &[f32], b: &[f32]) -> f64 {
 /// rates are averaged over all texts of full batches (a last, partial batch is dropped, as in
 /// the protocol). Ties count against the text.
 pub fn r_precision(texts: &[Vec<f32>], motions: &[Vec<f32>], batch: usize) -> [f64; 3] {
-    assert_eq!(texts.len(), motions.len(), "one motion per text");
+    let ranks: Vec<usize> = batch_ranks(texts, motions, batch)
+        .into_iter()
+        .flatten()
+        .collect();
     let mut hits = [0usize; 3];
-    let mut counted = 0;
+    for nearer in &ranks {
+        for (k, hit) in hits.iter_mut().enumerate() {
+            if *nearer <= k {
+                *hit += 1;
+            }
+        }
+    }
+    hits.map(|h| h as f64 / ranks.len().max(1) as f64)
+}
+
+/// For each text, how many other motions of its batch of `batch` are at least as near to it
+/// as its own motion (0 = its own motion ranks first); `None` for texts past the last whole
+/// batch, which R-precision leaves out.
+pub fn batch_ranks(texts: &[Vec<f32>], motions: &[Vec<f32>], batch: usize) -> Vec<Option<usize>> {
+    assert_eq!(texts.len(), motions.len(), "one motion per text");
+    let mut ranks = vec![None; texts.len()];
     for start in (0..texts.len()).step_by(batch.max(1)) {
         let end = start + batch;
         if end > texts.len() {
@@ -32,19 +50,13 @@ pub fn r_precision(texts: &[Vec<f32>], motions: &[Vec<f32>], batch: usize) -> [f
         }
         for i in start..end {
             let own = distance(&texts[i], &motions[i]);
-            // Motions at most as near as the text's own one (itself excluded): its rank − 1.
             let nearer = (start..end)
                 .filter(|&j| j != i && distance(&texts[i], &motions[j]) <= own)
                 .count();
-            for (k, hit) in hits.iter_mut().enumerate() {
-                if nearer <= k {
-                    *hit += 1;
-                }
-            }
-            counted += 1;
+            ranks[i] = Some(nearer);
         }
     }
-    hits.map(|h| h as f64 / counted.max(1) as f64)
+    ranks
 }
 
 /// MM-Dist: the mean distance between each text and its own motion.
@@ -315,6 +327,9 @@ mod tests {
         assert_eq!(r_precision(&texts, &same, 32), [0.0, 0.0, 0.0]);
         // A partial last batch is dropped.
         assert_eq!(r_precision(&texts[..40], &texts[..40], 32), [1.0, 1.0, 1.0]);
+        let ranks = batch_ranks(&texts[..40], &texts[..40], 32);
+        assert_eq!(ranks.iter().filter(|r| **r == Some(0)).count(), 32);
+        assert!(ranks[32..].iter().all(Option::is_none));
     }
 
     #[test]

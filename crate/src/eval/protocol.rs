@@ -3,7 +3,7 @@
 //! captions, the evaluator embeds texts and motions, and the field's metrics are computed,
 //! repeated with fresh caption draws and seeds to give a mean and a 95 % interval per figure.
 
-use super::metrics::{diversity, fid, mm_dist, multimodality, r_precision, Interval};
+use super::metrics::{batch_ranks, diversity, fid, mm_dist, multimodality, r_precision, Interval};
 use super::probes::foot_skating;
 use crate::agents::llm::UreqTransport;
 use crate::dataset::motions::MotionSet;
@@ -73,6 +73,18 @@ pub struct Row {
     pub foot_skating: Interval,
     /// Repetitions the row was measured on.
     pub repeats: usize,
+    /// Top-3 R-precision of the captions of each motion capture source's test motions
+    /// (pooled over repetitions; the batches mix sources as the draw does), with how many
+    /// captions it counts. Empty when the dataset names no sources.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub top3_by_source: BTreeMap<String, SourceTop3>,
+}
+
+/// Top-3 R-precision over one source's test captions.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct SourceTop3 {
+    pub top3: f64,
+    pub captions: usize,
 }
 
 /// The metrics of one repetition of one source.
@@ -84,6 +96,8 @@ struct Figures {
     diversity: Vec<f64>,
     multimodality: Vec<f64>,
     skating: Vec<f64>,
+    /// Per source: captions whose own motion ranked in the top 3, and captions counted.
+    by_source: BTreeMap<String, (usize, usize)>,
 }
 
 impl Figures {
@@ -100,6 +114,14 @@ impl Figures {
                 .then(|| Interval::of(&self.multimodality)),
             foot_skating: Interval::of(&self.skating),
             repeats: self.top.len(),
+            top3_by_source: self
+                .by_source
+                .iter()
+                .map(|(source, (hits, n))| {
+                    let top3 = *hits as f64 / (*n).max(1) as f64;
+                    (source.clone(), SourceTop3 { top3, captions: *n })
+                })
+                .collect(),
         }
     }
 }
@@ -351,6 +373,15 @@ impl Protocol<'_> {
                     fig.multimodality.push(0.0);
                 }
                 fig.top.push(r_precision(&texts, &motions, BATCH));
+                for (k, rank) in batch_ranks(&texts, &motions, BATCH).iter().enumerate() {
+                    let (Some(rank), Some(source)) = (rank, &self.test.items[order[k]].source)
+                    else {
+                        continue;
+                    };
+                    let entry = fig.by_source.entry(source.clone()).or_default();
+                    entry.0 += (*rank < 3) as usize;
+                    entry.1 += 1;
+                }
                 fig.fid.push(fid(&real, &motions));
                 fig.mm_dist.push(mm_dist(&texts, &motions));
                 fig.diversity
@@ -389,6 +420,35 @@ pub fn markdown_table(rows: &BTreeMap<String, Row>, order: &[&str]) -> String {
             r.diversity,
             r.multimodality.map_or("–".to_string(), |m| m.to_string())
         ));
+    }
+    let sources: Vec<&String> = {
+        let mut all: Vec<&String> = rows
+            .values()
+            .flat_map(|r| r.top3_by_source.keys())
+            .collect();
+        all.sort();
+        all.dedup();
+        all
+    };
+    if !sources.is_empty() {
+        out.push_str("\nTop-3 R-precision of each source's test captions (pooled over the repetitions; captions counted in brackets):\n\n| motions |");
+        for s in &sources {
+            out.push_str(&format!(" {s} |"));
+        }
+        out.push_str("\n|---|");
+        out.push_str(&"---|".repeat(sources.len()));
+        out.push('\n');
+        for name in order {
+            let Some(r) = rows.get(*name) else { continue };
+            out.push_str(&format!("| {name} |"));
+            for s in &sources {
+                match r.top3_by_source.get(*s) {
+                    Some(t) => out.push_str(&format!(" {:.3} ({}) |", t.top3, t.captions)),
+                    None => out.push_str(" – |"),
+                }
+            }
+            out.push('\n');
+        }
     }
     out
 }

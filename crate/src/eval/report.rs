@@ -184,6 +184,7 @@ mod tests {
             multimodality: None,
             foot_skating: i,
             repeats,
+            top3_by_source: BTreeMap::new(),
         }
     }
 
