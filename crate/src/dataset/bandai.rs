@@ -125,59 +125,10 @@ pub enum Selection {
 /// Reads the selected clips of a `.tar.xz` archive or of an extracted folder, sorted by stem.
 pub fn read_clips(source: &Path, selection: &Selection) -> Result<Vec<SourceClip>> {
     let mut collected = Collected::default();
-    if source.is_dir() {
-        visit(source, &mut collected)?;
-    } else {
-        read_archive(source, &mut collected)?;
+    for (path, bytes) in crate::mocap::read_files(source, &wanted)? {
+        let text = String::from_utf8(bytes)
+            .map_err(|_| anyhow!("{path} in {} is not UTF-8 text", source.display()))?;
+        collected.add(&path, text);
     }
     collected.finish(selection)
-}
-
-#[cfg(feature = "native")]
-fn read_archive(source: &Path, collected: &mut Collected) -> Result<()> {
-    use std::io::Read;
-    let file =
-        std::fs::File::open(source).with_context(|| format!("cannot open {}", source.display()))?;
-    let mut archive =
-        tar::Archive::new(liblzma::read::XzDecoder::new(std::io::BufReader::new(file)));
-    for entry in archive
-        .entries()
-        .with_context(|| format!("{} is not a tar.xz archive", source.display()))?
-    {
-        let mut entry = entry.with_context(|| format!("reading {}", source.display()))?;
-        let path = entry.path()?.to_string_lossy().to_string();
-        if wanted(&path) {
-            let mut text = String::new();
-            entry
-                .read_to_string(&mut text)
-                .with_context(|| format!("reading {path} in {}", source.display()))?;
-            collected.add(&path, text);
-        }
-    }
-    Ok(())
-}
-
-#[cfg(not(feature = "native"))]
-fn read_archive(source: &Path, _: &mut Collected) -> Result<()> {
-    anyhow::bail!(
-        "{}: reading .tar.xz archives needs the native build (feature `native`)",
-        source.display()
-    )
-}
-
-fn visit(dir: &Path, collected: &mut Collected) -> Result<()> {
-    for entry in std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))? {
-        let path = entry?.path();
-        if path.is_dir() {
-            visit(&path, collected)?;
-        } else {
-            let name = path.to_string_lossy().replace('\\', "/");
-            if wanted(&name) {
-                let text = std::fs::read_to_string(&path)
-                    .with_context(|| format!("cannot read {name}"))?;
-                collected.add(&name, text);
-            }
-        }
-    }
-    Ok(())
 }

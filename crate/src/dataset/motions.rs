@@ -63,6 +63,24 @@ fn item_labels(dir: &Path) -> HashMap<String, Labelled> {
         .unwrap_or_default()
 }
 
+/// Each action's share of the total weight of `(action, weight)` pairs; unlabelled items go
+/// under `"(unlabelled)"`. Training logs it to show how often rare actions are drawn.
+pub fn action_shares<'a>(
+    weights: impl IntoIterator<Item = (Option<&'a str>, f64)>,
+) -> BTreeMap<String, f64> {
+    let mut shares: BTreeMap<String, f64> = BTreeMap::new();
+    for (label, weight) in weights {
+        *shares
+            .entry(label.unwrap_or("(unlabelled)").to_string())
+            .or_default() += weight;
+    }
+    let total: f64 = shares.values().sum();
+    shares
+        .values_mut()
+        .for_each(|v| *v /= total.max(f64::MIN_POSITIVE));
+    shares
+}
+
 /// A batch of equal-length crops, flattened as `batch × frames × 263` (normalised).
 #[derive(Clone, Debug)]
 pub struct CropBatch {
@@ -156,9 +174,8 @@ impl MotionSet {
     /// The share of crops each action gets under the current drawing (unlabelled items under
     /// `"(unlabelled)"`), for the training log.
     pub fn action_shares(&self) -> BTreeMap<String, f64> {
-        let mut shares: BTreeMap<String, f64> = BTreeMap::new();
         let mut previous = 0.0;
-        for (i, item) in self.items.iter().enumerate() {
+        action_shares(self.items.iter().enumerate().map(|(i, item)| {
             let weight = match self.cumulative.get(i) {
                 Some(c) => {
                     let w = c - previous;
@@ -167,14 +184,8 @@ impl MotionSet {
                 }
                 None => item.features.len() as f64,
             };
-            let label = item.content.as_deref().unwrap_or("(unlabelled)");
-            *shares.entry(label.to_string()).or_default() += weight;
-        }
-        let total: f64 = shares.values().sum();
-        shares
-            .values_mut()
-            .for_each(|v| *v /= total.max(f64::MIN_POSITIVE));
-        shares
+            (item.content.as_deref(), weight)
+        }))
     }
 
     /// The items `keep` accepts, with the same normalisation (and plain length-proportional

@@ -131,16 +131,12 @@ impl TokenSet {
         &self,
         weights: Option<&[f64]>,
     ) -> std::collections::BTreeMap<String, f64> {
-        let mut shares = std::collections::BTreeMap::new();
-        for (i, item) in self.items.iter().enumerate() {
-            let label = item.content.as_deref().unwrap_or("(unlabelled)");
-            *shares.entry(label.to_string()).or_insert(0.0) += weights.map_or(1.0, |w| w[i]);
-        }
-        let total: f64 = shares.values().sum();
-        shares
-            .values_mut()
-            .for_each(|v| *v /= total.max(f64::MIN_POSITIVE));
-        shares
+        crate::dataset::motions::action_shares(
+            self.items
+                .iter()
+                .enumerate()
+                .map(|(i, item)| (item.content.as_deref(), weights.map_or(1.0, |w| w[i]))),
+        )
     }
 
     /// A random batch of `draw.batch` motions of similar length (between ¾ of and the length
