@@ -87,8 +87,59 @@ pub struct CropBatch {
     pub batch: usize,
     pub frames: usize,
     pub data: Vec<f32>,
-    /// Which item and first frame each crop came from.
-    pub sources: Vec<(usize, usize)>,
+    /// `batch × frames`: 1 for a frame of the motion, 0 for a frame that pads a shorter
+    /// motion (its last frame held). Losses count the frames of the motion only.
+    pub mask: Vec<f32>,
+    /// Which item each crop came from, its first source frame and its speed (1 = as
+    /// captured; see [`CropSpec`]).
+    pub sources: Vec<CropDraw>,
+}
+
+/// How training crops are drawn.
+#[derive(Clone, Copy, Debug)]
+pub struct CropSpec {
+    /// Longest crop in frames (20 fps).
+    pub max_frames: usize,
+    /// Crop lengths are multiples of this (the VQ-VAE's frames per token).
+    pub multiple: usize,
+    /// Chance that a crop is replayed at another speed ([`features::retime`]), in 0..=1.
+    pub retime_chance: f64,
+    /// The largest speed factor of a replay: factors are drawn log-uniformly in
+    /// `[1 / retime_max, retime_max]`; 1 replays nothing.
+    pub retime_max: f64,
+}
+
+impl CropSpec {
+    /// Crops of at most `max_frames`, in multiples of `multiple`, at the captured speed.
+    pub fn plain(max_frames: usize, multiple: usize) -> CropSpec {
+        CropSpec {
+            max_frames,
+            multiple,
+            retime_chance: 0.0,
+            retime_max: 1.0,
+        }
+    }
+}
+
+/// One crop of a batch: where it comes from and how many of its frames are the motion's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CropDraw {
+    pub item: usize,
+    /// First source frame.
+    pub start: usize,
+    /// Playback speed (1 = as captured).
+    pub speed: f64,
+    /// Frames of the motion in the crop; the rest of the crop holds its last frame.
+    pub real: usize,
+}
+
+/// Rows a motion of `len` rows has when played at `speed` (see [`features::retime`]).
+fn rows_at_speed(len: usize, speed: f64) -> usize {
+    if len == 0 {
+        0
+    } else {
+        ((len - 1) as f64 / speed + 1e-9).floor() as usize + 1
+    }
 }
 
 impl MotionSet {
@@ -231,39 +282,119 @@ impl MotionSet {
         self.items.len() - 1
     }
 
-    /// `batch` random crops of one length: an anchor item (drawn in proportion to its length)
-    /// sets the length to at most `max_frames`, rounded down to a multiple of `multiple`; the
-    /// other crops come from items at least that long. Short motions thus train too, in
-    /// batches of their own length.
-    pub fn sample_crops(
+    /// Where the crops of one batch come from: `batch` items drawn by weight, each replayed
+    /// at another speed with the spec's chance, and the batch's length: the longest drawn
+    /// (replayed) item, at most `max_frames`, rounded down to a multiple of `multiple`. Every
+    /// drawn item trains: one shorter than that is taken whole and padded by holding its last
+    /// frame, so short clips (one squat, one hop) get the share of crops their weight asks for.
+    pub fn draw_crops(
         &self,
         rng: &mut Rng,
         batch: usize,
-        max_frames: usize,
-        multiple: usize,
-    ) -> CropBatch {
+        spec: &CropSpec,
+    ) -> (usize, Vec<CropDraw>) {
         let total = self.frames();
-        let anchor = self.weighted_item(rng, total);
-        let len = self.items[anchor].features.len().min(max_frames);
-        let frames = (len / multiple * multiple).max(multiple.min(len));
-        let mut sources = Vec::with_capacity(batch);
-        let mut data = Vec::with_capacity(batch * frames * FEATURE_DIM);
-        let mut pick = anchor;
-        while sources.len() < batch {
-            let item = &self.items[pick];
-            if item.features.len() >= frames {
-                let start = rng.below(item.features.len() - frames + 1);
-                for row in &item.features[start..start + frames] {
-                    data.extend_from_slice(row);
+        let picks: Vec<(usize, f64)> = (0..batch)
+            .map(|_| {
+                let item = self.weighted_item(rng, total);
+                let speed = if spec.retime_max > 1.0 && (rng.uniform() as f64) < spec.retime_chance
+                {
+                    spec.retime_max.powf(2.0 * rng.uniform() as f64 - 1.0)
+                } else {
+                    1.0
+                };
+                (item, speed)
+            })
+            .collect();
+        let longest = picks
+            .iter()
+            .map(|&(i, s)| rows_at_speed(self.items[i].features.len(), s))
+            .max()
+            .unwrap_or(0);
+        let multiple = spec.multiple.max(1);
+        let frames = (longest.min(spec.max_frames) / multiple * multiple).max(multiple);
+        let draws = picks
+            .into_iter()
+            .map(|(item, speed)| {
+                let len = self.items[item].features.len();
+                let rows = rows_at_speed(len, speed);
+                if rows >= frames {
+                    // Source rows that `frames` rows at this speed span.
+                    let span = (((frames - 1) as f64 * speed - 1e-9).ceil() as usize + 1).min(len);
+                    let start = rng.below(len - span + 1);
+                    CropDraw {
+                        item,
+                        start,
+                        speed,
+                        real: frames,
+                    }
+                } else {
+                    CropDraw {
+                        item,
+                        start: 0,
+                        speed,
+                        real: rows,
+                    }
                 }
-                sources.push((pick, start));
+            })
+            .collect();
+        (frames, draws)
+    }
+
+    /// Frames of the motions (padding left out) that each source (`(unnamed)` where
+    /// `dataset.json` names none) gets over `batches` batches as [`MotionSet::draw_crops`]
+    /// draws them, as shares of the total: what training really sees of each source, which
+    /// the draw weights alone do not tell when clips are shorter than the crops.
+    pub fn crop_frame_shares(
+        &self,
+        rng: &mut Rng,
+        batches: usize,
+        batch: usize,
+        spec: &CropSpec,
+    ) -> BTreeMap<String, f64> {
+        let draws: Vec<CropDraw> = (0..batches)
+            .flat_map(|_| self.draw_crops(rng, batch, spec).1)
+            .collect();
+        action_shares(draws.iter().map(|d| {
+            (
+                Some(self.items[d.item].source.as_deref().unwrap_or("(unnamed)")),
+                d.real as f64,
+            )
+        }))
+    }
+
+    /// A batch of crops drawn as [`MotionSet::draw_crops`] says.
+    pub fn sample_crops(&self, rng: &mut Rng, batch: usize, spec: &CropSpec) -> CropBatch {
+        let (frames, sources) = self.draw_crops(rng, batch, spec);
+        let mut data = Vec::with_capacity(batch * frames * FEATURE_DIM);
+        let mut mask = Vec::with_capacity(batch * frames);
+        for draw in &sources {
+            let item = &self.items[draw.item].features;
+            let rows = if draw.speed == 1.0 {
+                item[draw.start..draw.start + draw.real].to_vec()
+            } else {
+                let span = (((draw.real.max(1) - 1) as f64 * draw.speed - 1e-9).ceil() as usize
+                    + 1)
+                .min(item.len() - draw.start);
+                let window = self
+                    .normalizer
+                    .denormalize(&item[draw.start..draw.start + span]);
+                let mut rows = self
+                    .normalizer
+                    .normalize(&features::retime(&window, draw.speed));
+                rows.truncate(draw.real);
+                rows
+            };
+            for t in 0..frames {
+                data.extend_from_slice(&rows[t.min(rows.len() - 1)]);
+                mask.push((t < rows.len()) as u8 as f32);
             }
-            pick = self.weighted_item(rng, total);
         }
         CropBatch {
             batch,
             frames,
             data,
+            mask,
             sources,
         }
     }
@@ -273,10 +404,11 @@ impl MotionSet {
 mod tests {
     use super::*;
 
+    /// An item whose row `t` holds `t` in every column, so crops show where they came from.
     fn item(content: &str, frames: usize) -> MotionItem {
         MotionItem {
             name: format!("{content}_{frames}"),
-            features: vec![[0.0; FEATURE_DIM]; frames],
+            features: (0..frames).map(|t| [t as f32; FEATURE_DIM]).collect(),
             captions: Vec::new(),
             parts: BTreeMap::new(),
             content: Some(content.to_string()),
@@ -313,5 +445,111 @@ mod tests {
         assert!((1800..2200).contains(&squats), "{squats} of 4000");
         set.balance(0.0);
         assert_eq!(set.action_shares(), plain);
+    }
+
+    fn plain_set(items: Vec<MotionItem>) -> MotionSet {
+        MotionSet {
+            items,
+            normalizer: Normalizer {
+                mean: vec![0.0; FEATURE_DIM],
+                std: vec![1.0; FEATURE_DIM],
+            },
+            cumulative: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn short_items_are_cropped_whole_and_padded_with_their_last_frame() {
+        let mut long = item("walk", 200);
+        long.source = Some("bandai".into());
+        let mut short = item("squat", 10);
+        short.source = Some("hdm05".into());
+        let mut set = plain_set(vec![long, short]);
+        set.balance(1.0);
+        let mut rng = Rng::new(3);
+        let mut shorts = 0;
+        for _ in 0..50 {
+            let batch = set.sample_crops(&mut rng, 16, &CropSpec::plain(64, 4));
+            assert_eq!(batch.data.len(), 16 * batch.frames * FEATURE_DIM);
+            assert_eq!(batch.mask.len(), 16 * batch.frames);
+            for (b, draw) in batch.sources.iter().enumerate() {
+                let row = |t: usize| batch.data[(b * batch.frames + t) * FEATURE_DIM];
+                let mask = &batch.mask[b * batch.frames..(b + 1) * batch.frames];
+                if draw.item == 1 {
+                    shorts += 1;
+                    assert_eq!(draw.real, 10);
+                    // Every frame of the clip, then its last frame held, masked out.
+                    for t in 0..batch.frames {
+                        assert_eq!(row(t), t.min(9) as f32);
+                        assert_eq!(mask[t], (t < 10) as u8 as f32);
+                    }
+                } else {
+                    assert_eq!(draw.real, batch.frames);
+                    assert!(mask.iter().all(|&m| m == 1.0));
+                    for t in 0..batch.frames {
+                        assert_eq!(row(t), (draw.start + t) as f32);
+                    }
+                }
+            }
+        }
+        // Balanced, each action is drawn about half the time, and no draw of the short one
+        // is thrown away.
+        assert!((300..500).contains(&shorts), "{shorts} of 800");
+        // Its share of real frames follows: 10 frames a draw against 64.
+        let shares = set.crop_frame_shares(&mut rng, 200, 16, &CropSpec::plain(64, 4));
+        let expected = 10.0 / (10.0 + 64.0);
+        assert!((shares["hdm05"] - expected).abs() < 0.03, "{shares:?}");
+    }
+
+    #[test]
+    fn crops_are_no_longer_than_the_longest_drawn_item() {
+        let set = plain_set(vec![item("squat", 23), item("hop", 17)]);
+        let mut rng = Rng::new(9);
+        for _ in 0..20 {
+            let batch = set.sample_crops(&mut rng, 4, &CropSpec::plain(64, 4));
+            let longest = batch
+                .sources
+                .iter()
+                .map(|d| set.items[d.item].features.len())
+                .max()
+                .unwrap();
+            assert_eq!(batch.frames, longest / 4 * 4);
+        }
+        // A clip shorter than one token still makes a crop of one token.
+        let tiny = plain_set(vec![item("tap", 2)]);
+        let batch = tiny.sample_crops(&mut rng, 2, &CropSpec::plain(64, 4));
+        assert_eq!(
+            (batch.frames, batch.mask[..4].to_vec()),
+            (4, vec![1.0, 1.0, 0.0, 0.0])
+        );
+    }
+
+    #[test]
+    fn replayed_crops_are_the_motion_at_another_speed() {
+        let set = plain_set(vec![item("walk", 300)]);
+        let spec = CropSpec {
+            retime_chance: 1.0,
+            retime_max: 1.5,
+            ..CropSpec::plain(64, 4)
+        };
+        let mut rng = Rng::new(4);
+        let mut speeds = Vec::new();
+        for _ in 0..10 {
+            let batch = set.sample_crops(&mut rng, 4, &spec);
+            assert_eq!(batch.frames, 64);
+            for (b, draw) in batch.sources.iter().enumerate() {
+                assert!((1.0 / 1.5..=1.5).contains(&draw.speed), "{}", draw.speed);
+                speeds.push(draw.speed);
+                // Row t of the ramp 0, 1, 2, … is frame start + t·speed (velocity columns
+                // are scaled by the speed too; column 3 is the root height).
+                for t in [0, 31, 63] {
+                    let v = batch.data[(b * 64 + t) * FEATURE_DIM + 3];
+                    let expected = draw.start as f64 + t as f64 * draw.speed;
+                    assert!((v as f64 - expected).abs() < 1e-3, "{v} vs {expected}");
+                }
+                assert!(batch.mask[b * 64..(b + 1) * 64].iter().all(|&m| m == 1.0));
+            }
+        }
+        assert!(speeds.iter().any(|&s| s < 0.95) && speeds.iter().any(|&s| s > 1.05));
     }
 }

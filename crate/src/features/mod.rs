@@ -325,6 +325,48 @@ pub fn mirror_features(features: &[FeatureFrame]) -> Features {
         .collect()
 }
 
+/// The same motion played `speed` times as fast (features, not normalised): row `k` of the
+/// result is the motion at source frame `k · speed`, linearly interpolated, with every
+/// per-frame displacement (root turn, root and joint velocities) scaled by `speed` and the
+/// foot contacts read again from the scaled foot velocities with the dataset's threshold.
+/// Training uses it to show a model the timings that a few actors did not perform; it is
+/// approximate (a 6D rotation interpolated linearly is not exactly a rotation), which
+/// training tolerates and exports never see. Returns as many rows as fit in the motion:
+/// `⌊(T − 1) / speed⌋ + 1`, or none for no rows or a speed that is not positive and finite.
+pub fn retime(features: &[FeatureFrame], speed: f64) -> Features {
+    if features.is_empty() || !(speed.is_finite() && speed > 0.0) {
+        return Vec::new();
+    }
+    let last = features.len() - 1;
+    let rows = (last as f64 / speed + 1e-9).floor() as usize + 1;
+    let scaled = |c: usize| {
+        ROOT_ROT_VEL.contains(&c) || ROOT_LIN_VEL.contains(&c) || VELOCITIES.contains(&c)
+    };
+    (0..rows)
+        .map(|k| {
+            let at = (k as f64 * speed).min(last as f64);
+            let i = (at.floor() as usize).min(last);
+            let (a, b) = (&features[i], &features[(i + 1).min(last)]);
+            let w = (at - i as f64) as f32;
+            let mut row: FeatureFrame = std::array::from_fn(|c| a[c] + (b[c] - a[c]) * w);
+            for (c, v) in row.iter_mut().enumerate() {
+                if scaled(c) {
+                    *v *= speed as f32;
+                }
+            }
+            for (slot, j) in [joint::L_ANKLE, joint::L_FOOT, joint::R_ANKLE, joint::R_FOOT]
+                .into_iter()
+                .enumerate()
+            {
+                let c = VELOCITIES.start + j * 3;
+                let sq: f32 = row[c..c + 3].iter().map(|v| v * v).sum();
+                row[CONTACTS.start + slot] = ((sq as f64) < FOOT_CONTACT_THRESHOLD) as u8 as f32;
+            }
+            row
+        })
+        .collect()
+}
+
 /// Running sums over feature rows, to fit a [`Normalizer`] without keeping the rows.
 #[derive(Clone, Debug)]
 pub struct FeatureStats {
@@ -579,6 +621,57 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn retimed_features_match_features_of_the_joints_taken_at_that_speed() {
+        let poses = synthetic(81);
+        let target = Offsets::from_pose(&poses[0]);
+        let (feats, _) = joints_to_features(&poses, &target).unwrap();
+        assert_eq!(retime(&feats, 1.0), feats);
+        assert_eq!(retime(&feats, 0.5).len(), 2 * (feats.len() - 1) + 1);
+        assert!(retime(&feats, 0.0).is_empty() && retime(&feats, f64::NAN).is_empty());
+        // Twice as fast is every other joint frame; a displacement over two frames is twice
+        // the one-frame one up to the motion's curvature. (The facing frame that velocities are
+        // written in is smoothed over neighbouring frames, which differ at the two rates, so
+        // speeds are compared, not components.)
+        let every_other: Vec<Pose> = poses.iter().step_by(2).copied().collect();
+        let (truth, _) = joints_to_features(&every_other, &target).unwrap();
+        let fast = retime(&feats, 2.0);
+        assert_eq!(fast.len(), 40);
+        let norm = |v: &[f32]| v.iter().map(|x| x * x).sum::<f32>().sqrt();
+        for (t, (a, b)) in fast.iter().zip(&truth).enumerate() {
+            assert!((a[3] - b[3]).abs() < 1e-4, "frame {t} root height");
+            for j in 0..NUM_JOINTS - 1 {
+                let c = POSITIONS.start + j * 3;
+                let across = |r: &FeatureFrame| norm(&[r[c], r[c + 2]]);
+                assert!(
+                    (a[c + 1] - b[c + 1]).abs() < 1e-4,
+                    "frame {t} joint {}",
+                    j + 1
+                );
+                assert!(
+                    (across(a) - across(b)).abs() < 1e-4,
+                    "frame {t} joint {}",
+                    j + 1
+                );
+            }
+            for j in 0..NUM_JOINTS {
+                let c = VELOCITIES.start + j * 3;
+                let (u, v) = (norm(&a[c..c + 3]), norm(&b[c..c + 3]));
+                assert!((u - v).abs() < 0.03, "frame {t} joint {j}: {u} vs {v}");
+            }
+            let (u, v) = (norm(&a[ROOT_LIN_VEL]), norm(&b[ROOT_LIN_VEL]));
+            assert!((u - v).abs() < 0.03, "frame {t} root: {u} vs {v}");
+        }
+        // The feet of the synthetic walk slide, so faster play reads fewer contacts.
+        let contacts = |f: &[FeatureFrame]| {
+            f.iter()
+                .map(|r| r[CONTACTS].iter().sum::<f32>())
+                .sum::<f32>()
+                / f.len() as f32
+        };
+        assert!(contacts(&retime(&feats, 3.0)) <= contacts(&feats));
     }
 
     #[test]

@@ -4,9 +4,9 @@
 //! on held-out motions.
 
 use super::run::Run;
-use crate::dataset::motions::MotionSet;
+use crate::dataset::motions::{CropSpec, MotionSet};
 use crate::dataset::Split;
-use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM, POSITIONS};
+use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM, POSITIONS, ROOT_ROT_VEL};
 use crate::geom;
 use crate::model::vq::{MotionVq, VqConfig};
 use crate::rng::Rng;
@@ -29,6 +29,13 @@ pub struct VqTrainingConfig {
     /// Longest crop in frames (at 20 fps); shorter motions train in batches of their length.
     #[config(default = 64)]
     pub max_frames: usize,
+    /// Chance that a crop is replayed at another speed (`features::retime`): timings the few
+    /// actors of the small sources did not perform. 0 replays nothing.
+    #[config(default = 0.0)]
+    pub retime_chance: f64,
+    /// The largest speed factor of a replayed crop (factors log-uniform in `[1/max, max]`).
+    #[config(default = 1.25)]
+    pub retime_max: f64,
     /// How strongly crops favour rare actions (see `MotionSet::balance`: 0 draws in
     /// proportion to length, 1 gives every action the same share).
     #[config(default = 0.0)]
@@ -53,6 +60,12 @@ pub struct VqTrainingConfig {
     /// Weight of the term on frame-to-frame changes of those positions.
     #[config(default = 0.5)]
     pub velocity_weight: f64,
+    /// Weight of the heading term: smooth L1 (β = 0.05 rad) between the reconstructed and the
+    /// true facing angle, each integrated from the root's turn per frame since the crop's
+    /// start. A small error in the turn per frame costs little in the other terms but
+    /// integrates into a drifting heading that turns the whole body. 0 leaves it out.
+    #[config(default = 0.0)]
+    pub heading_weight: f64,
     #[config(default = 5.0)]
     pub checkpoint_minutes: f64,
     /// Steps between progress lines.
@@ -115,16 +128,38 @@ pub fn train_vq(
     ));
     let (mut run, resumed) = Run::open(
         &options.run_dir,
-        &["loss", "reconstruction", "commitment", "codes_reset"],
+        &[
+            "loss",
+            "reconstruction",
+            "commitment",
+            "heading",
+            "codes_reset",
+        ],
     )?;
     config
         .save(options.run_dir.join("config.json"))
         .context("saving config.json")?;
 
+    let spec = CropSpec {
+        retime_chance: config.retime_chance,
+        retime_max: config.retime_max,
+        ..CropSpec::plain(config.max_frames, FRAMES_PER_TOKEN)
+    };
     progress(&format!(
         "share of crops per action: {}",
         super::format_shares(&train.action_shares())
     ));
+    progress(&format!(
+        "real crop frames per source (100 sampled batches): {}",
+        super::format_shares(&train.crop_frame_shares(
+            &mut Rng::new(config.seed),
+            100,
+            config.batch_size,
+            &spec
+        ))
+    ));
+    // The turn column in radians of heading: stored normalised, as half the angle.
+    let turn_scale = 2.0 * train.normalizer.std[ROOT_ROT_VEL.start] as f64;
     let mut model = run.start_from(
         config.model.init(device),
         options.init.as_deref(),
@@ -141,6 +176,7 @@ pub fn train_vq(
     }
 
     let smooth_l1 = SmoothL1LossConfig::new().init();
+    let heading_l1 = SmoothL1LossConfig::new().with_beta(0.05).init();
     let epoch_steps =
         (train.frames() as f64 / (config.batch_size * config.max_frames) as f64).max(1.0);
     while run.state.step < config.steps {
@@ -148,41 +184,59 @@ pub fn train_vq(
         // Each step's randomness depends only on the seed and the step, so a resumed run
         // continues exactly as an uninterrupted one would.
         let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        let crops = train.sample_crops(
-            &mut rng,
-            config.batch_size,
-            config.max_frames,
-            FRAMES_PER_TOKEN,
-        );
-        let x = batch_tensor(crops.data, crops.batch, crops.frames, device);
+        let crops = train.sample_crops(&mut rng, config.batch_size, &spec);
+        let (b, t) = (crops.batch, crops.frames);
+        let x = batch_tensor(crops.data, b, t, device);
+        let mask: Tensor<3> = Tensor::from_data(TensorData::new(crops.mask, [b, t, 1]), device);
 
         let out = model.forward_train(x.clone(), &config.model, &mut rng);
-        let recon = smooth_l1
-            .forward(out.reconstruction.clone(), x.clone())
-            .mean();
+        // Means over the motions' own frames: padding that holds a short clip's last frame
+        // is not the clip.
+        let masked_mean = |loss: Tensor<3>, mask: Tensor<3>| {
+            let columns = loss.dims()[2] as f64;
+            (loss * mask.clone()).sum() / (mask.sum() * columns).clamp_min(1.0)
+        };
+        let recon = masked_mean(
+            smooth_l1.forward(out.reconstruction.clone(), x.clone()),
+            mask.clone(),
+        );
         let pos_pred = out.reconstruction.clone().slice(s![.., .., POSITIONS]);
         let pos_true = x.clone().slice(s![.., .., POSITIONS]);
-        let positions = smooth_l1.forward(pos_pred.clone(), pos_true.clone()).mean();
-        let t = crops.frames;
+        let positions = masked_mean(
+            smooth_l1.forward(pos_pred.clone(), pos_true.clone()),
+            mask.clone(),
+        );
         let vel_pred =
             pos_pred.clone().slice(s![.., 1..t, ..]) - pos_pred.slice(s![.., 0..t - 1, ..]);
         let vel_true =
             pos_true.clone().slice(s![.., 1..t, ..]) - pos_true.slice(s![.., 0..t - 1, ..]);
-        let velocity = smooth_l1.forward(vel_pred, vel_true).mean();
+        let pair_mask =
+            mask.clone().slice(s![.., 1..t, ..]) * mask.clone().slice(s![.., 0..t - 1, ..]);
+        let velocity = masked_mean(smooth_l1.forward(vel_pred, vel_true), pair_mask);
+        let turn_error = (out.reconstruction.clone().slice(s![.., .., ROOT_ROT_VEL])
+            - x.clone().slice(s![.., .., ROOT_ROT_VEL]))
+            * mask.clone()
+            * turn_scale;
+        let heading = masked_mean(
+            heading_l1.forward(turn_error.cumsum(1), Tensor::zeros([b, t, 1], device)),
+            mask,
+        );
         let loss = recon.clone()
             + positions * config.position_weight
             + velocity * config.velocity_weight
+            + heading.clone() * config.heading_weight
             + out.commitment.clone() * config.commitment;
 
         let values = [
             loss.clone().into_scalar::<f32>() as f64,
             recon.into_scalar::<f32>() as f64,
             out.commitment.clone().into_scalar::<f32>() as f64,
+            heading.into_scalar::<f32>() as f64,
         ];
         let grads = GradientsParams::from_grads(loss.backward(), &model);
         model = optim.step(learning_rate(config, step), model, grads);
         let reset = model.update_codebooks(&out.assignments, config.model.ema_decay, &mut rng);
-        let logged = [values[0], values[1], values[2], reset as f64];
+        let logged = [values[0], values[1], values[2], values[3], reset as f64];
         run.record(crops.batch, &logged)?;
 
         let done = run.state.step;
@@ -199,13 +253,16 @@ pub fn train_vq(
                 usize::MAX,
             )?;
             progress(&format!(
-                "step {done}: validation reconstruction error {:.1} mm root-aligned MPJPE, {:.1} mm with the root path integrated",
-                e.root_aligned_mm, e.global_mm
+                "step {done}: validation reconstruction error {:.1} mm root-aligned MPJPE, {:.1} mm with the root path integrated, {:.1} mm posture",
+                e.root_aligned_mm, e.global_mm, e.posture_mm
             ));
             super::run::append_csv(
                 &options.run_dir.join("val.csv"),
-                "step,mpjpe_root_aligned_mm,error_root_integrated_mm",
-                &format!("{done},{:.3},{:.3}", e.root_aligned_mm, e.global_mm),
+                "step,mpjpe_root_aligned_mm,error_root_integrated_mm,posture_mm",
+                &format!(
+                    "{done},{:.3},{:.3},{:.3}",
+                    e.root_aligned_mm, e.global_mm, e.posture_mm
+                ),
             )?;
         }
         if run.end_step(
@@ -228,25 +285,138 @@ pub fn train_vq(
     Ok(())
 }
 
-/// Joint positions of normalised features.
-fn joints_of(normalized: &[FeatureFrame], normalizer: &Normalizer) -> Vec<crate::skeleton::Pose> {
-    features::features_to_joints(&normalizer.denormalize(normalized))
-}
-
-/// Reconstruction errors of a VQ-VAE on whole motions, in millimetres.
+/// Reconstruction errors of a VQ-VAE on whole motions, in millimetres, each a mean over
+/// every joint of every frame (the pelvis included).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct ReconstructionError {
-    /// Mean per-joint position error of the joints recovered from the features, root path
-    /// integrated (drift included).
+    /// Joints recovered from the features with the root path integrated (drift included).
     pub global_mm: f64,
-    /// The same with both skeletons' pelvis put at the same place in every frame.
+    /// The same with both skeletons' pelvis put at the same place in every frame (the field's
+    /// MPJPE). A drifting heading still turns the body here.
     pub root_aligned_mm: f64,
+    /// The posture alone: pelvis-relative joints in the body's own facing frame, read from the
+    /// features before any root motion is integrated. `root_aligned_mm` far above it means
+    /// the error is in the integrated heading, not in the pose.
+    pub posture_mm: f64,
     /// Motions measured.
     pub motions: usize,
+    /// Joint positions measured (motions × frames × 22).
+    joints: usize,
+}
+
+impl ReconstructionError {
+    /// Pools two measurements, weighting each by its joint positions.
+    pub fn pool(self, other: ReconstructionError) -> ReconstructionError {
+        let n = (self.joints + other.joints).max(1) as f64;
+        let mean = |a: f64, b: f64| (a * self.joints as f64 + b * other.joints as f64) / n;
+        ReconstructionError {
+            global_mm: mean(self.global_mm, other.global_mm),
+            root_aligned_mm: mean(self.root_aligned_mm, other.root_aligned_mm),
+            posture_mm: mean(self.posture_mm, other.posture_mm),
+            motions: self.motions + other.motions,
+            joints: self.joints + other.joints,
+        }
+    }
+}
+
+/// The errors of one motion reconstructed whole (cut to a multiple of 4 frames) from its
+/// first `layers` residual layers; `None` for a motion shorter than one token.
+fn motion_error(
+    model: &MotionVq,
+    item: &[FeatureFrame],
+    normalizer: &Normalizer,
+    device: &Device,
+    layers: usize,
+) -> Result<Option<ReconstructionError>> {
+    let t = item.len() / FRAMES_PER_TOKEN * FRAMES_PER_TOKEN;
+    if t == 0 {
+        return Ok(None);
+    }
+    let frames = &item[..t];
+    let x = batch_tensor(frames.iter().flatten().copied().collect(), 1, t, device);
+    // Only the first `layers` residual layers: what a decoder sees when the later layers
+    // are left out (quantisation dropout trained it for that).
+    let tokens: Vec<_> = model
+        .tokenize(x)
+        .into_iter()
+        .map(|mut part| {
+            part.truncate(layers.max(1));
+            part
+        })
+        .collect();
+    let y: Vec<f32> = model
+        .decode(&tokens)
+        .try_into_vec_as::<f32>()
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let recon: Vec<FeatureFrame> = y
+        .chunks_exact(FEATURE_DIM)
+        .map(|c| c.try_into().expect("263 columns"))
+        .collect();
+    let (mut global, mut aligned, mut posture) = (0.0, 0.0, 0.0);
+    let (truth_rows, guess_rows) = (
+        normalizer.denormalize(frames),
+        normalizer.denormalize(&recon),
+    );
+    for (a, b) in truth_rows.iter().zip(&guess_rows) {
+        for j in 0..crate::skeleton::NUM_JOINTS - 1 {
+            let c = POSITIONS.start + j * 3;
+            let (p, q) = (&a[c..c + 3], &b[c..c + 3]);
+            posture += p
+                .iter()
+                .zip(q)
+                .map(|(u, v)| ((u - v) as f64).powi(2))
+                .sum::<f64>()
+                .sqrt();
+        }
+    }
+    let truth = features::features_to_joints(&truth_rows);
+    let guess = features::features_to_joints(&guess_rows);
+    for (a, b) in truth.iter().zip(&guess) {
+        for (p, q) in a.iter().zip(b) {
+            global += geom::dist(*p, *q);
+            aligned += geom::dist(geom::sub(*p, a[0]), geom::sub(*q, b[0]));
+        }
+    }
+    let joints = t * crate::skeleton::NUM_JOINTS;
+    let mm = |sum: f64| sum / joints as f64 * 1000.0;
+    Ok(Some(ReconstructionError {
+        global_mm: mm(global),
+        root_aligned_mm: mm(aligned),
+        posture_mm: mm(posture),
+        motions: 1,
+        joints,
+    }))
 }
 
 /// Reconstructs up to `limit` motions of `set` whole (each cut to a multiple of 4 frames) and
-/// measures the joint errors.
+/// measures the joint errors, pooled over every motion and per group that `group` names
+/// (source, action): each motion is reconstructed once.
+pub fn reconstruction_errors_by(
+    model: &MotionVq,
+    set: &MotionSet,
+    device: &Device,
+    limit: usize,
+    layers: usize,
+    group: impl Fn(&crate::dataset::motions::MotionItem) -> Option<String>,
+) -> Result<(
+    ReconstructionError,
+    std::collections::BTreeMap<String, ReconstructionError>,
+)> {
+    let mut all = ReconstructionError::default();
+    let mut groups = std::collections::BTreeMap::<String, ReconstructionError>::new();
+    for item in set.items.iter().take(limit) {
+        if let Some(e) = motion_error(model, &item.features, &set.normalizer, device, layers)? {
+            all = all.pool(e);
+            if let Some(key) = group(item) {
+                let slot = groups.entry(key).or_default();
+                *slot = slot.pool(e);
+            }
+        }
+    }
+    Ok((all, groups))
+}
+
+/// [`reconstruction_errors_by`] pooled over every motion only.
 pub fn reconstruction_errors(
     model: &MotionVq,
     set: &MotionSet,
@@ -254,49 +424,7 @@ pub fn reconstruction_errors(
     limit: usize,
     layers: usize,
 ) -> Result<ReconstructionError> {
-    let (mut global, mut aligned, mut count, mut motions) = (0.0, 0.0, 0usize, 0usize);
-    for item in set.items.iter().take(limit) {
-        let t = item.features.len() / FRAMES_PER_TOKEN * FRAMES_PER_TOKEN;
-        if t == 0 {
-            continue;
-        }
-        let frames = &item.features[..t];
-        let x = batch_tensor(frames.iter().flatten().copied().collect(), 1, t, device);
-        // Only the first `layers` residual layers: what a decoder sees when the later layers
-        // are left out (quantisation dropout trained it for that).
-        let tokens: Vec<_> = model
-            .tokenize(x)
-            .into_iter()
-            .map(|mut part| {
-                part.truncate(layers.max(1));
-                part
-            })
-            .collect();
-        let y: Vec<f32> = model
-            .decode(&tokens)
-            .try_into_vec_as::<f32>()
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let recon: Vec<FeatureFrame> = y
-            .chunks_exact(FEATURE_DIM)
-            .map(|c| c.try_into().expect("263 columns"))
-            .collect();
-        let truth = joints_of(frames, &set.normalizer);
-        let guess = joints_of(&recon, &set.normalizer);
-        for (a, b) in truth.iter().zip(&guess) {
-            for (p, q) in a.iter().zip(b) {
-                global += geom::dist(*p, *q);
-                aligned += geom::dist(geom::sub(*p, a[0]), geom::sub(*q, b[0]));
-                count += 1;
-            }
-        }
-        motions += 1;
-    }
-    let n = count.max(1) as f64;
-    Ok(ReconstructionError {
-        global_mm: global / n * 1000.0,
-        root_aligned_mm: aligned / n * 1000.0,
-        motions,
-    })
+    Ok(reconstruction_errors_by(model, set, device, limit, layers, |_| None)?.0)
 }
 
 /// How predictable one residual layer's codes are, over a set of motions: entropies in nats

@@ -23,6 +23,9 @@ pub struct VqErrorArgs {
     /// Decode from the first N residual layers only (default: all).
     #[arg(long)]
     layers: Option<usize>,
+    /// Also print the errors of each source's actions (their content labels).
+    #[arg(long)]
+    by_action: bool,
     /// Also print how predictable each residual layer's codes are (entropies in nats).
     #[arg(long)]
     codes: bool,
@@ -42,18 +45,51 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
     let model = coma::weights::load_file(cfg.model.init(&device), &args.weights)?;
     let set = coma::dataset::motions::MotionSet::load(&args.data, split)?;
     let layers = args.layers.unwrap_or(cfg.model.layers);
-    let e = coma::train::vq::reconstruction_errors(&model, &set, &device, args.limit, layers)?;
+    let by_action = args.by_action;
+    let (e, groups) = coma::train::vq::reconstruction_errors_by(
+        &model,
+        &set,
+        &device,
+        args.limit,
+        layers,
+        |item| {
+            let source = item.source.clone()?;
+            Some(match (by_action, &item.content) {
+                (true, Some(action)) => format!("{source}\t{action}"),
+                _ => source,
+            })
+        },
+    )?;
     println!(
-        "{} motions of the {:?} split, {layers} of {} layers: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned)",
-        e.motions, split, cfg.model.layers, e.global_mm, e.root_aligned_mm
+        "{} motions of the {:?} split, {layers} of {} layers: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned), {:.1} mm (posture: pelvis-relative, in the body's facing frame)",
+        e.motions, split, cfg.model.layers, e.global_mm, e.root_aligned_mm, e.posture_mm
     );
-    for source in set.sources() {
-        let part = set.subset(|i| i.source.as_deref() == Some(source.as_str()));
-        let e = coma::train::vq::reconstruction_errors(&model, &part, &device, args.limit, layers)?;
+    // Per source, then (with --by-action) its actions under it.
+    let mut sources: std::collections::BTreeMap<&str, coma::train::vq::ReconstructionError> =
+        Default::default();
+    for (key, g) in &groups {
+        let source = key.split('\t').next().unwrap_or(key);
+        let slot = sources.entry(source).or_default();
+        *slot = slot.pool(*g);
+    }
+    for (source, s) in &sources {
         println!(
-            "  {source}: {} motions, {:.1} mm (root path integrated), {:.1} mm (root aligned)",
-            e.motions, e.global_mm, e.root_aligned_mm
+            "  {source}: {} motions, {:.1} mm (root path integrated), {:.1} mm (root aligned), {:.1} mm (posture)",
+            s.motions, s.global_mm, s.root_aligned_mm, s.posture_mm
         );
+        for (key, g) in groups
+            .iter()
+            .filter(|(k, _)| k.starts_with(&format!("{source}\t")))
+        {
+            println!(
+                "    {:<32} {:>4} motions  {:>6.1} {:>6.1} {:>6.1}",
+                key.split('\t').nth(1).unwrap_or(""),
+                g.motions,
+                g.global_mm,
+                g.root_aligned_mm,
+                g.posture_mm
+            );
+        }
     }
     if args.codes {
         println!("layer  used  H(code)  H(code | layer below)  H(code | layer 0)   (nats; ln 256 = 5.55)");
