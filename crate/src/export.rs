@@ -102,9 +102,7 @@ pub fn export_spam(
             .map_err(|e| anyhow::anyhow!("{}: {e}", run.join("config.json").display()))
     };
     let sizes = SpamConfig::new(
-        VqTrainingConfig::load(vq.join("config.json"))
-            .map_err(|e| anyhow::anyhow!("{}: {e}", vq.join("config.json").display()))?
-            .model,
+        <VqTrainingConfig as crate::train::ReadConfig>::read(&vq.join("config.json"))?.model,
         transformer(base)?,
     )
     .with_residual(res.map(transformer).transpose()?);

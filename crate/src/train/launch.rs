@@ -12,11 +12,11 @@ use super::transformer::{
     train_transformer, Kind, TransformerTrainOptions, TransformerTrainingConfig,
 };
 use super::vq::VqTrainingConfig;
+use super::ReadConfig;
 use crate::dataset::motions::MotionSet;
 use crate::dataset::Split;
 use crate::text::minilm::SentenceEncoder;
 use anyhow::{Context, Result};
-use burn::config::Config;
 use burn::tensor::Device;
 use std::path::Path;
 
@@ -47,8 +47,7 @@ pub fn train_transformer_on_dataset(
     progress: &dyn Fn(&str),
 ) -> Result<()> {
     let plain = Device::flex();
-    let vq_cfg = VqTrainingConfig::load(sources.vq_config)
-        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", sources.vq_config.display()))?;
+    let vq_cfg = VqTrainingConfig::read(sources.vq_config)?;
     let vq = crate::weights::load_file(vq_cfg.model.init(&plain), sources.vq)
         .context("cannot load the VQ-VAE")?;
     // A run whose checkpoint has reached its (possibly lowered) step count only writes its

@@ -34,3 +34,48 @@ pub fn format_shares(shares: &std::collections::BTreeMap<String, f64>) -> String
         .collect::<Vec<_>>()
         .join(", ")
 }
+
+/// A training configuration as a run folder or `configs/` holds it.
+pub trait ReadConfig: burn::config::Config {
+    /// Reads the configuration at `path`.
+    fn read(path: &std::path::Path) -> anyhow::Result<Self>;
+}
+
+/// Reads a training configuration, taking each field the file lacks from `defaults` (the
+/// code's own defaults, given the file's contents for what has none): a run written before a
+/// field existed still loads, and means what it meant when the field's default keeps the old
+/// behaviour.
+pub fn read_with_defaults<C: burn::config::Config>(
+    path: &std::path::Path,
+    defaults: impl FnOnce(&serde_json::Value) -> anyhow::Result<C>,
+) -> anyhow::Result<C> {
+    use anyhow::Context;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut value: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let filled = serde_json::to_value(defaults(&value)?)?;
+    if let (Some(fields), serde_json::Value::Object(all)) = (value.as_object_mut(), filled) {
+        for (key, default) in all {
+            fields.entry(key).or_insert(default);
+        }
+    }
+    serde_json::from_value(value)
+        .with_context(|| format!("{} is not a valid configuration", path.display()))
+}
+
+/// Configurations that have added no field since runs were first written: read as they are.
+macro_rules! read_as_written {
+    ($($config:ty),*) => {$(
+        impl ReadConfig for $config {
+            fn read(path: &std::path::Path) -> anyhow::Result<Self> {
+                <$config as burn::config::Config>::load(path)
+                    .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))
+            }
+        }
+    )*};
+}
+read_as_written!(
+    transformer::TransformerTrainingConfig,
+    evaluator::EvaluatorTrainingConfig
+);

@@ -78,6 +78,18 @@ pub struct VqTrainingConfig {
     pub seed: u64,
 }
 
+impl super::ReadConfig for VqTrainingConfig {
+    /// Fields added since a run was written (speed replays, the heading term) take their
+    /// defaults, which leave them out.
+    fn read(path: &std::path::Path) -> Result<Self> {
+        super::read_with_defaults(path, |file| {
+            let model = serde_json::from_value(file.get("model").cloned().unwrap_or_default())
+                .with_context(|| format!("{} has no valid \"model\"", path.display()))?;
+            Ok(VqTrainingConfig::new(model))
+        })
+    }
+}
+
 /// Learning rate of a step: linear warm-up, then constant, then a tenth.
 fn learning_rate(config: &VqTrainingConfig, step: usize) -> f64 {
     let base = config.learning_rate;

@@ -165,7 +165,7 @@ pub struct RunArgs {
 impl RunArgs {
     /// The run folder of network `name` and its configuration, with `--steps` applied by
     /// `set_steps`.
-    pub fn open<C: burn::config::Config>(
+    pub fn open<C: coma::train::ReadConfig>(
         &self,
         name: &str,
         set_steps: impl FnOnce(&mut C, usize),
@@ -182,8 +182,7 @@ impl RunArgs {
                 PathBuf::from(format!("configs/{name}.json"))
             }
         });
-        let mut config =
-            C::load(&path).map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
+        let mut config = C::read(&path)?;
         if let Some(s) = self.steps {
             set_steps(&mut config, s);
         }

@@ -32,15 +32,13 @@ pub struct VqErrorArgs {
 }
 
 pub fn run(args: VqErrorArgs) -> Result<()> {
-    use burn::config::Config;
     let split = match args.split.as_str() {
         "train" => coma::dataset::Split::Train,
         "val" => coma::dataset::Split::Val,
         "test" => coma::dataset::Split::Test,
         other => bail!("unknown split '{other}' (train, val or test)"),
     };
-    let cfg = coma::train::vq::VqTrainingConfig::load(&args.config)
-        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", args.config.display()))?;
+    let cfg = <coma::train::vq::VqTrainingConfig as coma::train::ReadConfig>::read(&args.config)?;
     let device = burn::tensor::Device::flex();
     let model = coma::weights::load_file(cfg.model.init(&device), &args.weights)?;
     let set = coma::dataset::motions::MotionSet::load(&args.data, split)?;
