@@ -191,7 +191,7 @@ fn missing_archive_gives_a_clear_error() {
 #[test]
 fn training_loads_the_split_crops_it_and_resumes_a_run() {
     use burn::prelude::*;
-    use coma::dataset::motions::MotionSet;
+    use coma::dataset::motions::{CropSpec, MotionSet};
     use coma::dataset::Split;
     use coma::model::vq::VqConfig;
     use coma::rng::Rng;
@@ -212,7 +212,7 @@ fn training_loads_the_split_crops_it_and_resumes_a_run() {
     let set = MotionSet::load(&out, Split::Train).unwrap();
     let mut rng = Rng::new(3);
     for _ in 0..10 {
-        let crops = set.sample_crops(&mut rng, 8, 64, 4);
+        let crops = set.sample_crops(&mut rng, 8, &CropSpec::plain(64, 4));
         assert_eq!(crops.frames % 4, 0);
         assert!(crops.frames <= 64 && crops.frames >= 20);
         assert_eq!(crops.data.len(), 8 * crops.frames * FEATURE_DIM);

@@ -479,9 +479,9 @@ mod tests {
                     shorts += 1;
                     assert_eq!(draw.real, 10);
                     // Every frame of the clip, then its last frame held, masked out.
-                    for t in 0..batch.frames {
+                    for (t, &m) in mask.iter().enumerate() {
                         assert_eq!(row(t), t.min(9) as f32);
-                        assert_eq!(mask[t], (t < 10) as u8 as f32);
+                        assert_eq!(m, (t < 10) as u8 as f32);
                     }
                 } else {
                     assert_eq!(draw.real, batch.frames);

@@ -11,7 +11,8 @@ use crate::plan::Plan;
 
 /// What planning reads besides the prompt.
 pub struct PlanningContext<'a> {
-    /// The model's training vocabulary (`vocabulary.json`); the LLM planner needs it.
+    /// The model's training vocabulary (`vocabulary.json`); the LLM planner needs it, and the
+    /// built-in planner reads which actions the model makes from it.
     pub vocabulary: Option<&'a Vocabulary>,
     /// MiniLM sentence embeddings, so the built-in planner can map unknown movements onto
     /// the training actions.
@@ -65,7 +66,7 @@ pub(super) async fn plan_with<T: Transport>(
                 )),
                 Llm::Off => None,
             };
-            planner::offline::plan(prompt, context.embed)
+            planner::offline::plan_for(prompt, context.vocabulary, context.embed)
         }
     };
     plan.notes.splice(0..0, fallback_note);
@@ -79,4 +80,42 @@ pub(super) async fn plan_with<T: Transport>(
         }
     }
     Ok(plan)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::agents::llm::UreqTransport;
+    use crate::executor::block_on;
+
+    fn plan(vocabulary: &Vocabulary) -> Plan {
+        let context = PlanningContext {
+            vocabulary: Some(vocabulary),
+            embed: None,
+        };
+        let off = Llm::<UreqTransport>::Off;
+        block_on(plan_prompt(
+            "a person squats",
+            None,
+            &off,
+            &context,
+            &mut |_| {},
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn the_built_in_planner_plans_the_actions_of_the_models_vocabulary() {
+        let mut vocabulary: Vocabulary =
+            serde_json::from_str(include_str!("../../../static/models/vocabulary.json")).unwrap();
+        // v1 has no squats: the posture library's.
+        let v1 = plan(&vocabulary);
+        assert_eq!(v1.segments[0].base, "a person stands still");
+        assert!(v1.segments[0].postures.is_some());
+        vocabulary.actions.insert("squat".into(), 104);
+        vocabulary.words.extend(["does".into(), "squat".into()]);
+        let v2 = plan(&vocabulary);
+        assert_eq!(v2.segments[0].base, "a person does a squat");
+        assert!(v2.segments[0].postures.is_none());
+    }
 }

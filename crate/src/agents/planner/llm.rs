@@ -39,7 +39,7 @@ pub async fn plan<T: Transport>(
     progress: &mut dyn FnMut(&PlanEvent),
 ) -> Plan {
     let mut notes = Vec::new();
-    let offline_plan = offline::plan(prompt, embed);
+    let offline_plan = offline::plan_for(prompt, Some(vocabulary), embed);
     let context = vocabulary_brief(vocabulary);
 
     // The text the later steps read: the LLM's rewrite, or the user's prompt itself when the
@@ -64,7 +64,7 @@ pub async fn plan<T: Transport>(
         Ok(pieces) => pieces,
         Err(e) => {
             notes.push(e.note("segment"));
-            offline::plan(&source, embed)
+            offline::plan_for(&source, Some(vocabulary), embed)
                 .segments
                 .into_iter()
                 .map(|s| (s.text, s.seconds))
@@ -86,7 +86,9 @@ pub async fn plan<T: Transport>(
             Ok(segment) => segment,
             Err(e) => {
                 notes.push(e.note(&format!("decompose (segment {})", index + 1)));
-                let mut s = offline::plan(&text, embed).segments.remove(0);
+                let mut s = offline::plan_for(&text, Some(vocabulary), embed)
+                    .segments
+                    .remove(0);
                 s.seconds = seconds;
                 s
             }

@@ -12,9 +12,14 @@
 //!    the data uses.
 //! 4. A clause with no known movement is mapped to the nearest training action by sentence
 //!    similarity when an embedder is given, and dropped otherwise, with a note either way.
+//!
+//! The actions of dataset v2 (squat, jump, lie down, kicks, throw, …) are planned as the
+//! model's own motion only when the model's vocabulary lists them ([`plan_for`]); otherwise,
+//! and for poses held ("holds a deep squat"), the posture library makes what it can of them.
 
-use super::lexicon::{self, Action, Direction, Side};
+use super::lexicon::{self, Action, Direction, Repertoire, Side};
 use super::postures;
+use crate::dataset::Vocabulary;
 use crate::plan::{
     clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS, MAX_TEXT_CHARS,
 };
@@ -42,9 +47,18 @@ pub fn is_unplanned_note(note: &str) -> bool {
 /// Longest prompt read, in characters; the rest is ignored with a note.
 pub const MAX_PROMPT_CHARS: usize = 2000;
 
-/// Plans `prompt` with the built-in rules. `embed` (optional) maps unknown movements onto the
-/// training actions. Always returns a plan of 1 to [`MAX_SEGMENTS`] segments.
+/// Plans `prompt` with the built-in rules for a model that knows the Bandai Namco actions
+/// only (as [`plan_for`] with no vocabulary).
 pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
+    plan_for(prompt, None, embed)
+}
+
+/// Plans `prompt` with the built-in rules for the model whose training vocabulary is
+/// `vocabulary`: the actions of dataset v2 it lists are made by the model. `embed` (optional)
+/// maps unknown movements onto the training actions. Always returns a plan of 1 to
+/// [`MAX_SEGMENTS`] segments.
+pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Embedder>) -> Plan {
+    let known = Repertoire::new(vocabulary);
     let mut notes = Vec::new();
     let mut text: String = prompt.chars().take(MAX_PROMPT_CHARS).collect();
     if prompt.chars().count() > MAX_PROMPT_CHARS {
@@ -56,31 +70,75 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
     let style = prompt_style(&text);
     let mut segments: Vec<Segment> = Vec::new();
     let mut previous: Option<Action> = None;
-    for clause in clauses(&text) {
-        let words: Vec<&str> = clause.iter().map(String::as_str).collect();
-        let model = movements(&words, previous);
+    // The dataset v2 action the last segment made, whose clip ends standing again.
+    let mut ends_standing: Option<Action> = None;
+    let clauses = clauses(&text, known);
+    let clauses: Vec<Vec<&str>> = clauses
+        .iter()
+        .map(|c| c.iter().map(String::as_str).collect())
+        .collect();
+    let readers: Vec<Reader> = (0..clauses.len())
+        .map(|k| Reader {
+            known,
+            pose_kept: clauses
+                .get(k + 1)
+                .is_some_and(|next| postures::keeps_pose_before(next)),
+        })
+        .collect();
+    for (k, words) in clauses.iter().enumerate() {
+        let words = words.as_slice();
+        let reader = readers[k];
+        if ends_standing.is_some() && postures::stands_up(words) {
+            // "squats down and stands back up": the squat's clips stand back up already.
+            continue;
+        }
+        let model = movements(words, previous, reader);
+        let next_dataset_action = clauses
+            .get(k + 1)
+            .and_then(|next| movements(next, None, readers[k + 1]))
+            .map(|m| m.base)
+            .filter(|a| a.label().is_some());
+        if model.is_none()
+            && next_dataset_action.is_some_and(|next| postures::leads_into(words, next))
+        {
+            // "kneels and then lies down": the model's lying down kneels on the way.
+            continue;
+        }
         let model_segment = || match &model {
-            Some(found) => segment(&words, found, style.as_deref()),
+            Some(found) => segment(words, found, style.as_deref()),
             None => segment(
-                &words,
+                words,
                 &Movements {
                     base: Action::Walk(Direction::Forward),
                     gestures: Vec::new(),
+                    at: 0,
                 },
                 style.as_deref(),
             ),
         };
         let model_parts = model.as_ref().map(|m| (m.base, m.gestures.as_slice()));
-        if let Some(planned) = postures::plan_clause(&words, model_parts, &model_segment) {
+        if let Some(planned) = postures::plan_clause(words, model_parts, &model_segment) {
             notes.extend(planned.notes);
-            postures::land_in(&words, segments.last_mut(), &planned.segment);
+            postures::land_in(words, segments.last_mut(), &planned.segment);
             previous = None;
-            segments.push(planned.segment);
+            ends_standing = None;
+            // A dataset action with a posture held on its arms is still the model's movement,
+            // counted as one ("does two squats in a T-pose").
+            let times = match &model {
+                Some(found) if planned.over_model && found.base.label().is_some() => {
+                    ends_standing = Some(found.base).filter(|a| *a != Action::LieDown);
+                    repetitions(words, found, &mut notes)
+                }
+                _ => 1,
+            };
+            for _ in 0..times {
+                segments.push(planned.segment.clone());
+            }
             continue;
         }
-        if let (None, Some(stay)) = (&model, postures::stay(&words)) {
+        if let (None, Some(stay)) = (&model, postures::stay(words)) {
             let held = match (stay, segments.last()) {
-                (postures::Stay::Hold, Some(last)) => postures::hold_segment(&words, last),
+                (postures::Stay::Hold, Some(last)) => postures::hold_segment(words, last),
                 _ => None,
             };
             match (held, segments.last_mut()) {
@@ -96,7 +154,7 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
         }
         let found = match model {
             Some(found) => found,
-            None => match nearest_action(&words, embed) {
+            None => match nearest_action(words, embed, known) {
                 Some((action, similarity)) => {
                     notes.push(format!(
                         "\"{}\" {SUBSTITUTED}; used the nearest one, \"{}\" \
@@ -107,6 +165,7 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
                     Movements {
                         base: action,
                         gestures: Vec::new(),
+                        at: 0,
                     }
                 }
                 None => {
@@ -118,8 +177,9 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
             },
         };
         previous = Some(found.gestures.last().copied().unwrap_or(found.base));
-        let segment = segment(&words, &found, style.as_deref());
-        for _ in 0..lexicon::repetitions(&words) {
+        ends_standing = Some(found.base).filter(|a| a.label().is_some() && *a != Action::LieDown);
+        let segment = segment(words, &found, style.as_deref());
+        for _ in 0..repetitions(words, &found, &mut notes) {
             segments.push(segment.clone());
         }
     }
@@ -171,6 +231,52 @@ pub fn rewrite(segments: &[Segment]) -> String {
 struct Movements {
     base: Action,
     gestures: Vec<Action>,
+    /// The index of the word that names the base.
+    at: usize,
+}
+
+/// What reading a clause depends on besides its words.
+#[derive(Clone, Copy, Debug)]
+struct Reader<'a> {
+    /// The actions of dataset v2 the model makes.
+    known: Repertoire<'a>,
+    /// The clause after this one holds its pose or lands it in a named posture ("squats and
+    /// holds it", "jumps up and lands in a superhero landing"), which the posture library
+    /// makes.
+    pose_kept: bool,
+}
+
+impl Reader<'_> {
+    /// A clause read on its own, for splitting the prompt into clauses.
+    fn alone(known: Repertoire) -> Reader {
+        Reader {
+            known,
+            pose_kept: false,
+        }
+    }
+}
+
+/// How many segments a clause's movement takes: "twice", "three times"; for an action of
+/// dataset v2 also a count before its noun ("three squats", "3 kicks"), at most
+/// [`MAX_SEGMENTS`] (with a note when more were asked).
+fn repetitions(words: &[&str], found: &Movements, notes: &mut Vec<String>) -> usize {
+    let said = lexicon::repetitions(words);
+    if found.base.label().is_none() {
+        return said;
+    }
+    let asked = if said > 1 {
+        said
+    } else {
+        lexicon::count_before(words, found.at).unwrap_or(1)
+    };
+    if asked > MAX_SEGMENTS {
+        notes.push(format!(
+            "\"{}\" asks for {asked}; a plan has at most {MAX_SEGMENTS} segments, so it makes \
+             {MAX_SEGMENTS}",
+            words.join(" ")
+        ));
+    }
+    asked.clamp(1, MAX_SEGMENTS)
 }
 
 /// How a clause starts: a marker that changes its order or merges it with the next one.
@@ -224,13 +330,14 @@ fn tokens(text: &str) -> Vec<String> {
 }
 
 /// True when the words start a new verb phrase, after an optional subject.
-fn starts_verb(words: &[String]) -> bool {
+fn starts_verb(words: &[String], known: Repertoire) -> bool {
     let mut i = 0;
     // Determiners take a noun, and the noun an adjective or two: "the old man bows".
     while i < words.len() && i < 4 {
         let w = words[i].as_str();
         let next: Vec<&str> = words[i + 1..].iter().take(3).map(String::as_str).collect();
-        if (lexicon::is_finite_verb(w) || postures::is_posture_verb(w))
+        let dataset_verb = known.knows_any() && lexicon::is_dataset_verb(w);
+        if (lexicon::is_finite_verb(w) || postures::is_posture_verb(w) || dataset_verb)
             && !(w == "turn" && next.first() == Some(&"to"))
         {
             // "left" after "turn" is part of the verb; a bare side word is not a verb.
@@ -252,16 +359,16 @@ fn action_or_other(word: &str, next: &[&str]) -> bool {
 }
 
 /// Cuts the prompt into clauses in time order.
-fn clauses(text: &str) -> Vec<Vec<String>> {
+fn clauses(text: &str, known: Repertoire) -> Vec<Vec<String>> {
     let tokens = tokens(text);
     let mut out = Vec::new();
     for sentence in tokens.split(|t| t == ".") {
-        out.extend(sentence_clauses(sentence));
+        out.extend(sentence_clauses(sentence, known));
     }
     out
 }
 
-fn sentence_clauses(sentence: &[String]) -> Vec<Vec<String>> {
+fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> {
     let mut chunks: Vec<Chunk> = vec![Chunk {
         words: Vec::new(),
         marker: Marker::None,
@@ -294,7 +401,7 @@ fn sentence_clauses(sentence: &[String]) -> Vec<Vec<String>> {
                     .position(|t| !matches!(t.as_str(), "and" | "then" | "finally" | ","))
                     .unwrap_or(rest.len());
                 let connective = rest[..after].iter().any(|t| t == "then" || t == "finally");
-                if connective || starts_verb(&rest[after..]) || starts_connective(rest) {
+                if connective || starts_verb(&rest[after..], known) || starts_connective(rest) {
                     new_chunk(&mut chunks, Marker::None, false);
                 }
                 i += 1;
@@ -305,7 +412,7 @@ fn sentence_clauses(sentence: &[String]) -> Vec<Vec<String>> {
                 i += 1;
                 continue;
             }
-            "next" if starts_verb(rest) || rest.first().is_some_and(|t| t == ",") => {
+            "next" if starts_verb(rest, known) || rest.first().is_some_and(|t| t == ",") => {
                 new_chunk(&mut chunks, Marker::None, false);
                 i += 1;
                 continue;
@@ -317,7 +424,7 @@ fn sentence_clauses(sentence: &[String]) -> Vec<Vec<String>> {
                     .count();
                 if skip > 0 {
                     new_chunk(&mut chunks, Marker::None, false);
-                } else if starts_verb(rest) {
+                } else if starts_verb(rest, known) {
                     new_chunk(&mut chunks, Marker::None, true);
                 } else {
                     chunks.last_mut().unwrap().words.push(w.to_string());
@@ -360,7 +467,7 @@ fn sentence_clauses(sentence: &[String]) -> Vec<Vec<String>> {
         i += 1;
     }
     chunks.retain(|c| !c.words.is_empty());
-    order(chunks)
+    order(chunks, known)
 }
 
 fn starts_connective(rest: &[String]) -> bool {
@@ -372,7 +479,7 @@ fn starts_connective(rest: &[String]) -> bool {
 
 /// Puts "before" and "after" clauses in time order, joins "while" clauses and the soft "and"
 /// splits that are one movement.
-fn order(chunks: Vec<Chunk>) -> Vec<Vec<String>> {
+fn order(chunks: Vec<Chunk>, known: Repertoire) -> Vec<Vec<String>> {
     let mut out: Vec<Chunk> = Vec::new();
     let mut pending_before: Option<Chunk> = None;
     let mut pending_while: Option<Chunk> = None;
@@ -400,7 +507,7 @@ fn order(chunks: Vec<Chunk>) -> Vec<Vec<String>> {
         }
         if chunk.soft {
             if let Some(last) = out.last_mut() {
-                if soft_join(&last.words, &chunk.words) {
+                if soft_join(&last.words, &chunk.words, known) {
                     last.words.push("and".into());
                     last.words.append(&mut chunk.words);
                     continue;
@@ -418,29 +525,32 @@ fn order(chunks: Vec<Chunk>) -> Vec<Vec<String>> {
 }
 
 /// "walks forward and waves the left hand" is one movement: a walk carrying a gesture.
-fn soft_join(left: &[String], right: &[String]) -> bool {
+fn soft_join(left: &[String], right: &[String], known: Repertoire) -> bool {
     let l: Vec<&str> = left.iter().map(String::as_str).collect();
     let r: Vec<&str> = right.iter().map(String::as_str).collect();
-    let Some(b) = movements(&r, None) else {
+    let reader = Reader::alone(known);
+    let Some(b) = movements(&r, None, reader) else {
         return false;
     };
     let gesture = b.base.is_gesture() && b.gestures.is_empty();
     // A gesture rides on a walk, or on a posture the model does not know ("kneels and raises
     // the right hand").
-    let carries =
-        movements(&l, None).is_some_and(|a| a.base.is_locomotion()) || postures::names_posture(&l);
+    let carries = movements(&l, None, reader).is_some_and(|a| a.base.is_locomotion())
+        || postures::names_posture(&l);
     gesture && carries
 }
 
 /// The movements of one clause; `previous` lends its gesture to a clause with no verb ("then
 /// the left hand").
-fn movements(words: &[&str], previous: Option<Action>) -> Option<Movements> {
+fn movements(words: &[&str], previous: Option<Action>, reader: Reader) -> Option<Movements> {
     let mut actions: Vec<(usize, Action)> = Vec::new();
     for (i, w) in words.iter().enumerate() {
         let next = &words[i + 1..];
         let prev = &words[..i];
         let prev_rev: Vec<&str> = prev.iter().rev().copied().collect();
-        let Some(mut action) = lexicon::action_word(w, next, &prev_rev) else {
+        let Some(mut action) =
+            dataset_action(words, i, reader).or_else(|| lexicon::action_word(w, next, &prev_rev))
+        else {
             continue;
         };
         if *w == "sword" && actions.iter().any(|(_, a)| *a == Action::Slash) {
@@ -474,6 +584,7 @@ fn movements(words: &[&str], previous: Option<Action>) -> Option<Movements> {
         return Some(Movements {
             base: previous.with_side(side),
             gestures: Vec::new(),
+            at: 0,
         });
     }
     // A walk turning and walking is one turn.
@@ -503,7 +614,38 @@ fn movements(words: &[&str], previous: Option<Action>) -> Option<Movements> {
         used.extend_from_slice(a.arms());
         gestures.push(*a);
     }
-    Some(Movements { base, gestures })
+    Some(Movements {
+        base,
+        gestures,
+        at: actions[base_index].0,
+    })
+}
+
+/// The action of dataset v2 that word `i` names, where the model makes it and the posture
+/// library does not keep the clause (a pose held, a movement it names otherwise such as
+/// "jumping jacks", or a whole-body pose beside it).
+fn dataset_action(words: &[&str], i: usize, reader: Reader) -> Option<Action> {
+    let action = lexicon::dataset_action(words, i).or_else(|| jog_circle(words, i))?;
+    (reader.known.knows(action) && !postures::keeps(words, i, action, reader.pose_kept))
+        .then_some(action)
+}
+
+/// A jog or run round a circle or an arc of one ("jogs in a circle to the left", "jogs
+/// around, curving to the right"), the way it turns.
+fn jog_circle(words: &[&str], i: usize) -> Option<Action> {
+    if lexicon::action_word(words[i], &[], &[]) != Some(Action::Run) {
+        return None;
+    }
+    let Trajectory::Shape {
+        shape: Shape::Circle(side) | Shape::Arc(side),
+    } = path(words)?
+    else {
+        return None;
+    };
+    Some(Action::JogCircle(match side {
+        crate::trajectory::Side::Left => Side::Left,
+        crate::trajectory::Side::Right => Side::Right,
+    }))
 }
 
 fn same_kind(a: Action, b: Action) -> bool {
@@ -583,7 +725,11 @@ fn prompt_style(text: &str) -> Option<String> {
 }
 
 /// A clause of no known movement mapped onto the nearest training action by similarity.
-fn nearest_action(words: &[&str], embed: Option<Embedder>) -> Option<(Action, f32)> {
+fn nearest_action(
+    words: &[&str],
+    embed: Option<Embedder>,
+    known: Repertoire,
+) -> Option<(Action, f32)> {
     let embed = embed?;
     if words.is_empty()
         || !words
@@ -599,8 +745,13 @@ fn nearest_action(words: &[&str], embed: Option<Embedder>) -> Option<(Action, f3
         return None;
     }
     let query = embed(&format!("a person {}", words.join(" ")));
+    // The sided front kicks, where the model knows them, stand for the Bandai kick (as
+    // `dataset_action` reads "kicks").
+    let sided_kicks = known.knows(Action::FrontKick(Side::Right));
     TRAINING_ACTIONS
         .iter()
+        .filter(|a| !(sided_kicks && **a == Action::Kick))
+        .chain(lexicon::DATASET_ACTIONS.iter().filter(|a| known.knows(**a)))
         .map(|a| (*a, cosine(&query, &embed(&a.caption()))))
         .filter(|(_, s)| *s >= NEAREST_MIN_SIMILARITY)
         .max_by(|a, b| a.1.total_cmp(&b.1))

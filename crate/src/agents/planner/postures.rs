@@ -10,6 +10,10 @@
 //!   with a T-pose's arms). Gestures the model knows in the same clause ("kneels and raises the
 //!   right hand") stay the model's: the track then leaves those arms to it.
 //! - A clause that only asks to stay ("waits", "rests", "lies still") holds the pose before.
+//! - Where the model knows a movement of dataset v2 (a squat, a jump, lying down), the model
+//!   makes it, and a posture of the arms is held over it ("squats while striking a T-pose");
+//!   the library keeps poses held ("holds a deep squat", "squats and holds it"), and
+//!   movements and poses it names otherwise ("jumping jacks", "hops on one leg").
 
 use super::lexicon::{self, Action};
 use crate::plan::{clamp_seconds, PartEdits, Segment};
@@ -137,6 +141,118 @@ const PLAIN_GESTURE_WORDS: &[&str] = &[
     "the", "a", "his", "her", "their", "its", "left", "right", "both", "one", "hand", "hands",
     "arm", "arms", "up", "high", "in", "into", "air", "overhead",
 ];
+
+/// Words of holding a pose ("holds a squat", "stays in a squat", "and holds it").
+const HOLD_VERBS: &[&str] = &[
+    "hold",
+    "holds",
+    "holding",
+    "held",
+    "stay",
+    "stays",
+    "staying",
+    "remain",
+    "remains",
+    "remaining",
+    "freeze",
+    "freezes",
+    "frozen",
+];
+
+/// The library's names for what an action of dataset v2 also is, or passes through: a clause
+/// that names the action with these ("squats", "crouches down into a squat", "jumps up",
+/// "lies down", "crouches to set something down") is the model's when it knows the action;
+/// any other name there ("sumo squat", "jumping jacks") is the library's.
+fn library_names(action: Action) -> &'static [&'static str] {
+    match action {
+        Action::Squat => &["squat", "deep squat", "crouch"],
+        Action::Jump | Action::JumpForward => &["jump"],
+        Action::LieDown => &[
+            "lie on the back",
+            "kneel on both knees",
+            "kneel on one knee",
+        ],
+        Action::ReachUp(_) => &["stretching arms up"],
+        Action::PutDown(_) => &["crouch", "squat", "kneel on one knee"],
+        _ => &[],
+    }
+}
+
+/// Whether a clause only names poses that `action`, planned next, passes through
+/// ("kneels and then lies down": the model's lying down kneels on the way).
+pub fn leads_into(words: &[&str], action: Action) -> bool {
+    let mentions = Library::builtin().mentions(&words.join(" "));
+    let names = library_names(action);
+    !mentions.is_empty()
+        && mentions
+            .iter()
+            .all(|(_, n)| matches!(n, Named::Posture(_)) && names.contains(&n.name()))
+}
+
+/// Whether the posture library keeps the clause although the model knows `action`, named by
+/// word `at`: the word is part of the library's name for something else ("jumping jacks",
+/// "sumo squat", "creeps on hands and knees"); the clause names a whole-body pose besides
+/// ("hops on one leg"); or the action's pose is held, in the clause ("holds a squat", "stays
+/// in a squat", "a squat position") or, when `held_after`, by the clause after it.
+pub fn keeps(words: &[&str], at: usize, action: Action, held_after: bool) -> bool {
+    let same = library_names(action);
+    let text = words.join(" ");
+    let start: usize = words[..at].iter().map(|w| w.len() + 1).sum();
+    let mentions = Library::builtin().mentions(&text);
+    let other = |n: &Named| !same.contains(&n.name());
+    let claimed = mentions.iter().any(|(r, n)| r.contains(&start) && other(n));
+    let body_pose = mentions.iter().any(|(r, n)| {
+        !r.contains(&start) && other(n) && matches!(n, Named::Posture(p) if !arms_only(p))
+    });
+    let held = !same.is_empty() && (held_after || held_in(words, at));
+    claimed || body_pose || held
+}
+
+/// Whether the clause holds the pose of the movement at `at`: a word of holding before it,
+/// or a word of a pose after it, with only articles and such between ("holds a deep
+/// squat", "stays down in a squat", "squats into a squat position").
+fn held_in(words: &[&str], at: usize) -> bool {
+    const BETWEEN: &[&str] = &[
+        "a", "an", "the", "in", "into", "down", "low", "deep", "full", "his", "her", "their",
+        "its", "this", "that", "there",
+    ];
+    const POSE: &[&str] = &[
+        "position",
+        "pose",
+        "posture",
+        "stance",
+        "still",
+        "motionless",
+    ];
+    let before = words[..at].iter().rev().find(|w| !BETWEEN.contains(w));
+    let after = words[at + 1..].iter().find(|w| !BETWEEN.contains(w));
+    before.is_some_and(|w| HOLD_VERBS.contains(w)) || after.is_some_and(|w| POSE.contains(w))
+}
+
+/// Whether a clause holds the pose the clause before it ends in ("and holds it", "then stays
+/// there") or lands it in a named posture ("and lands in a superhero landing").
+pub fn keeps_pose_before(words: &[&str]) -> bool {
+    let first = words
+        .iter()
+        .find(|w| !lexicon::is_subject_word(w) && !is_subject_noun(w));
+    match first {
+        Some(&("land" | "lands")) => names_posture(words),
+        // "holds it", "holds for 3 seconds"; not "holds a T-pose", a pose of its own.
+        Some(w) => {
+            HOLD_VERBS.contains(w) && Library::builtin().mentions(&words.join(" ")).is_empty()
+        }
+        None => false,
+    }
+}
+
+/// Whether a clause only stands up ("stands back up", "gets up"), the library's movement.
+pub fn stands_up(words: &[&str]) -> bool {
+    let mentions = Library::builtin().mentions(&words.join(" "));
+    !mentions.is_empty()
+        && mentions
+            .iter()
+            .all(|(_, n)| matches!(n, Named::Action(_)) && n.name() == "stand up")
+}
 
 /// What a clause with no movement of its own asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -354,6 +470,9 @@ pub struct PostureClause {
     pub segment: Segment,
     /// Notes for the plan (postures that could not be combined).
     pub notes: Vec<String>,
+    /// The segment is the model's motion with postures held on some parts (a walk with the
+    /// arms in a T), not a posture segment.
+    pub over_model: bool,
 }
 
 /// The segment for a clause that names postures or movements of the library, or `None` when
@@ -368,7 +487,9 @@ pub fn plan_clause(
     let text = words.join(" ");
     let library = Library::builtin();
     let mut mentions = library.mentions(&text);
-    // A whole-body movement the model knows ("bows") stays the model's.
+    // A whole-body movement the model knows ("bows", or a squat where it knows squats) stays
+    // the model's.
+    let dataset_base = model.map(|(base, _)| base).filter(|b| b.label().is_some());
     let model_words: Vec<&str> = words
         .iter()
         .enumerate()
@@ -376,13 +497,21 @@ pub fn plan_clause(
             let next = &words[i + 1..];
             let prev: Vec<&str> = words[..*i].iter().rev().copied().collect();
             lexicon::action_word(w, next, &prev).is_some_and(|a| !a.is_gesture())
+                || dataset_base.is_some_and(|b| {
+                    lexicon::dataset_action(words, *i)
+                        .is_some_and(|a| std::mem::discriminant(&a) == std::mem::discriminant(&b))
+                })
         })
         .map(|(_, w)| *w)
         .collect();
-    mentions.retain(|(range, _)| {
+    // So do the poses a movement of dataset v2 passes through ("crouches down into a squat").
+    let passed = dataset_base.map_or(&[][..], library_names);
+    mentions.retain(|(range, named)| {
         let phrase = &text[range.clone()];
         let plain_raise = phrase.split(' ').all(|w| PLAIN_GESTURE_WORDS.contains(&w));
-        !plain_raise && !phrase.split(' ').any(|w| model_words.contains(&w))
+        !plain_raise
+            && !phrase.split(' ').any(|w| model_words.contains(&w))
+            && !passed.contains(&named.name())
     });
     if mentions.is_empty() {
         return None;
@@ -401,7 +530,7 @@ pub fn plan_clause(
     });
     let (arm_postures, body_postures): (Vec<&NamedPosture>, Vec<&NamedPosture>) =
         postures.iter().partition(|p| arms_only(p));
-    let locomotion = model.is_some_and(|(base, _)| base.is_locomotion());
+    let carries_arms = model.is_some_and(|(base, _)| base.frees_arms());
     // A gesture word inside a named posture ("points up with both hands", "one arm forward
     // and up") is the posture's, not a gesture of its own.
     let mut at = 0;
@@ -423,8 +552,8 @@ pub fn plan_clause(
         })
         .unwrap_or_default();
 
-    // The model's walk or run, with the arms held in a posture.
-    if locomotion && action.is_none() && body_postures.is_empty() {
+    // The model's walk, run or squat, with the arms held in a posture.
+    if carries_arms && action.is_none() && body_postures.is_empty() {
         let mut segment = model_segment();
         let arms = merge_arms(&arm_postures, &mut notes)?;
         let parts: Vec<BodyPart> = arm_postures.iter().flat_map(|p| p.parts.clone()).collect();
@@ -433,7 +562,11 @@ pub fn plan_clause(
         }
         segment.text = format!("{} holding {}", segment.text, describe_names(&arm_postures));
         segment.postures = Some(PostureTrack::holding(parts, arms));
-        return Some(PostureClause { segment, notes });
+        return Some(PostureClause {
+            segment,
+            notes,
+            over_model: true,
+        });
     }
 
     let count = repetitions(words, &text, action.as_ref().map(|(r, _)| r.start));
@@ -516,7 +649,11 @@ pub fn plan_clause(
         trajectory: None,
         postures: Some(track),
     };
-    Some(PostureClause { segment, notes })
+    Some(PostureClause {
+        segment,
+        notes,
+        over_model: false,
+    })
 }
 
 /// Nouns prompts use for the person ("the girl", "an athlete"): dropped from a segment's text.

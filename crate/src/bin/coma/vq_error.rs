@@ -23,6 +23,10 @@ pub struct VqErrorArgs {
     /// Decode from the first N residual layers only (default: all).
     #[arg(long)]
     layers: Option<usize>,
+    /// Only the motions of this source (bandai, hdm05, cmu, deepmimic): a source's training
+    /// clips against its test clips without measuring the whole training split.
+    #[arg(long)]
+    source: Option<String>,
     /// Also print the errors of each source's actions (their content labels).
     #[arg(long)]
     by_action: bool,
@@ -41,7 +45,13 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
     let cfg = <coma::train::vq::VqTrainingConfig as coma::train::ReadConfig>::read(&args.config)?;
     let device = burn::tensor::Device::flex();
     let model = coma::weights::load_file(cfg.model.init(&device), &args.weights)?;
-    let set = coma::dataset::motions::MotionSet::load(&args.data, split)?;
+    let mut set = coma::dataset::motions::MotionSet::load(&args.data, split)?;
+    if let Some(source) = &args.source {
+        set = set.subset(|i| i.source.as_deref() == Some(source.as_str()));
+        if set.items.is_empty() {
+            bail!("the {split:?} split has no motions of the source '{source}'");
+        }
+    }
     let layers = args.layers.unwrap_or(cfg.model.layers);
     let by_action = args.by_action;
     let (e, groups) = coma::train::vq::reconstruction_errors_by(

@@ -334,3 +334,369 @@ fn a_jump_lands_in_the_posture_the_next_clause_names() {
         .iter()
         .all(|k| k.jump_m.is_none()));
 }
+
+/// The shipped (v1) vocabulary: the Bandai Namco actions only.
+fn v1_vocabulary() -> Vocabulary {
+    serde_json::from_str(include_str!("../../../../../static/models/vocabulary.json")).unwrap()
+}
+
+/// A vocabulary of a model trained on dataset v2: v1's, plus every dataset v2 label and the
+/// words of the planner's phrase for it.
+fn v2_vocabulary() -> Vocabulary {
+    let mut vocabulary = v1_vocabulary();
+    for action in lexicon::DATASET_ACTIONS {
+        vocabulary.actions.insert(action.label().unwrap(), 10);
+        vocabulary.words.extend(
+            action
+                .verb_phrase()
+                .split(|c: char| !c.is_alphanumeric() && c != '-')
+                .filter(|w| !w.is_empty())
+                .map(String::from),
+        );
+    }
+    vocabulary.words.sort();
+    vocabulary.words.dedup();
+    vocabulary
+}
+
+fn bases(plan: &Plan) -> Vec<&str> {
+    plan.segments.iter().map(|s| s.base.as_str()).collect()
+}
+
+#[test]
+fn dataset_actions_are_the_models_when_its_vocabulary_lists_them() {
+    let v2 = v2_vocabulary();
+    let cases: &[(&str, &[&str])] = &[
+        ("a person squats", &["a person does a squat"]),
+        ("a person is squatting", &["a person does a squat"]),
+        ("the man does three squats", &["a person does a squat"; 3]),
+        ("a person does two squats", &["a person does a squat"; 2]),
+        ("he squats twice", &["a person does a squat"; 2]),
+        (
+            "a person does 3 kicks",
+            &["a person kicks with the right leg"; 3],
+        ),
+        ("someone jumps", &["a person jumps up"]),
+        ("a boy hops up and down", &["a person jumps up"]),
+        (
+            "a person leaps forward",
+            &["a person jumps forward with both feet"],
+        ),
+        (
+            "a person lies down on the floor",
+            &["a person lies down on the floor"],
+        ),
+        ("he lays down", &["a person lies down on the floor"]),
+        (
+            "she lies on the ground",
+            &["a person lies down on the floor"],
+        ),
+        (
+            "she kicks with the left foot",
+            &["a person kicks with the left leg"],
+        ),
+        ("a man kicks", &["a person kicks with the right leg"]),
+        (
+            "kicks a ball with the right foot",
+            &["a person kicks a ball with the right foot"],
+        ),
+        (
+            "a boy plays soccer with his left foot",
+            &["a person kicks a ball with the left foot"],
+        ),
+        ("throws a ball", &["a person throws a ball"]),
+        // Punches are thrown, not balls: still the Bandai punch.
+        ("a person throws punches", &["a person throws punches"]),
+        (
+            "reaches up high with the left hand",
+            &["a person reaches up high with the left hand"],
+        ),
+        (
+            "someone reaches for a high shelf",
+            &["a person reaches up high with the right hand"],
+        ),
+        ("sneaks forward", &["a person sneaks forward"]),
+        (
+            "a thief tiptoes across the room",
+            &["a person sneaks forward"],
+        ),
+        ("a person walks stealthily", &["a person sneaks forward"]),
+        (
+            "she puts the box down on the floor with her left hand",
+            &["a person places an object on the ground with the left hand"],
+        ),
+        (
+            "someone places a cup on the ground",
+            &["a person places an object on the ground with the right hand"],
+        ),
+        (
+            "the person does arm circles",
+            &["a person circles both arms backward"],
+        ),
+        (
+            "a person does elbow to knee exercises",
+            &["a person touches each elbow to the opposite knee"],
+        ),
+        ("a man plays basketball", &["a person plays basketball"]),
+        (
+            "the referee signals a foul",
+            &["a person makes referee signals with the arms"],
+        ),
+        (
+            "a police officer directs traffic",
+            &["a person directs traffic with arm signals"],
+        ),
+        ("a person washes a window", &["a person washes a window"]),
+        // The arm the action is made with carries no gesture of its own.
+        (
+            "she stretches her right arm up",
+            &["a person reaches up high with the right hand"],
+        ),
+        (
+            "a traffic cop waves cars through",
+            &["a person directs traffic with arm signals"],
+        ),
+        (
+            "a person dribbles a ball and shoots",
+            &["a person plays basketball"],
+        ),
+        (
+            "a person crouches down into a squat, then stands up",
+            &["a person does a squat"],
+        ),
+        (
+            "the person crouches to set something down with the left hand",
+            &["a person places an object on the ground with the left hand"],
+        ),
+        (
+            "a woman kneels and then lies down on the ground",
+            &["a person lies down on the floor"],
+        ),
+        (
+            "he reaches up and grabs a book with his left hand",
+            &["a person reaches up high with the left hand"],
+        ),
+        (
+            "a person squats, throws a ball, then lies down",
+            &[
+                "a person does a squat",
+                "a person throws a ball",
+                "a person lies down on the floor",
+            ],
+        ),
+    ];
+    let mut wrong = Vec::new();
+    for (prompt, expected) in cases {
+        let plan = plan_for(prompt, Some(&v2), None);
+        let plain = |s: &Segment| s.postures.is_none() && s.parts.edits().is_empty();
+        if bases(&plan) != *expected || !plan.segments.iter().all(plain) {
+            wrong.push(format!("{prompt:?}: {:?}", bases(&plan)));
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+
+    let seconds = |p: &str| plan_for(p, Some(&v2), None).segments[0].seconds;
+    // Lengths from the clips: a squat is shorter than a segment may be, lying down longer.
+    assert_eq!(seconds("a person squats"), 2.0);
+    assert_eq!(seconds("a person lies down"), 5.65);
+    assert_eq!(seconds("a person squats for 4 seconds"), 4.0);
+
+    let jog = plan_for("a person jogs in a circle clockwise", Some(&v2), None);
+    assert_eq!(bases(&jog), ["a person jogs in a circle to the right"]);
+    assert_eq!(
+        jog.segments[0].trajectory,
+        Trajectory::from_text("circle clockwise")
+    );
+
+    let many = plan_for("a person does ten squats", Some(&v2), None);
+    assert_eq!(bases(&many), ["a person does a squat"; MAX_SEGMENTS]);
+    assert!(many.notes.iter().any(|n| n.contains("asks for 10")));
+}
+
+#[test]
+fn every_training_caption_of_a_dataset_action_plans_as_that_action() {
+    let v2 = v2_vocabulary();
+    let mut wrong = Vec::new();
+    for action in lexicon::DATASET_ACTIONS {
+        let label = action.label().unwrap();
+        // Every wording (the count is more than there are).
+        let captions = crate::dataset::captions::global_captions(&label, "normal", "plan", 100);
+        assert!(captions.len() >= 8, "{label}: {captions:?}");
+        for caption in captions {
+            let planned = plan_for(&caption, Some(&v2), None);
+            if bases(&planned) != [action.caption()] {
+                wrong.push(format!("{label}: {caption:?} -> {:?}", bases(&planned)));
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn held_poses_and_the_librarys_own_movements_stay_with_the_posture_library() {
+    let v2 = v2_vocabulary();
+    for prompt in [
+        "a person holds a deep squat",
+        "she stays in a squat",
+        "a person squats and holds it",
+        "a woman lies on the back",
+        "he lies face down on the floor",
+        "a person does jumping jacks",
+        "a person hops on one leg",
+        "a person jumps backward",
+        "someone jumps up and lands in a superhero landing",
+        "a person reaches up with both hands",
+        "a man kneels on one knee",
+        "a person crouches down",
+        "a person crawls on all fours",
+    ] {
+        let before = plan(prompt, None);
+        let with_v2 = plan_for(prompt, Some(&v2), None);
+        assert_eq!(with_v2.segments, before.segments, "{prompt:?}");
+        assert!(
+            with_v2.segments[0].postures.is_some(),
+            "{prompt:?}: {with_v2:#?}"
+        );
+    }
+}
+
+#[test]
+fn a_posture_is_held_on_the_arms_over_the_models_squat() {
+    let prompt = "the girl squats while striking a T-pose, then walks forward waving the left hand";
+    let v2 = plan_for(prompt, Some(&v2_vocabulary()), None);
+    assert_eq!(
+        bases(&v2),
+        ["a person does a squat", "a person walks forward"],
+        "{v2:#?}"
+    );
+    let held = v2.segments[0].postures.as_ref().expect("the T-pose held");
+    assert_eq!(held.parts, [BodyPart::LeftArm, BodyPart::RightArm]);
+    assert_eq!(held.keys.len(), 1);
+    assert_eq!(held.keys[0].script.name.as_deref(), Some("T-pose"));
+    assert_eq!(
+        v2.segments[1].parts.left_arm.as_deref(),
+        Some("a person waves the left hand")
+    );
+    assert!(v2.segments[1].postures.is_none());
+    // Counted, it is still the model's squat, each with the arms held.
+    let two = plan_for(
+        "a person does two squats with the hands on the hips",
+        Some(&v2_vocabulary()),
+        None,
+    );
+    assert_eq!(bases(&two), ["a person does a squat"; 2]);
+    assert!(two.segments.iter().all(|s| s
+        .postures
+        .as_ref()
+        .is_some_and(|t| t.parts == [BodyPart::LeftArm, BodyPart::RightArm])));
+}
+
+#[test]
+fn standing_back_up_after_a_dataset_action_is_part_of_it() {
+    let v2 = v2_vocabulary();
+    let up = plan_for("a person squats down and stands back up", Some(&v2), None);
+    assert_eq!(bases(&up), ["a person does a squat"]);
+    // Lying down ends on the floor: getting up is a movement of its own.
+    let lying = plan_for("he lies down, then gets up", Some(&v2), None);
+    assert_eq!(lying.segments.len(), 2);
+    assert_eq!(lying.segments[0].base, "a person lies down on the floor");
+    assert!(lying.segments[1].postures.is_some());
+}
+
+/// A segment as recorded: its base and the names of its key poses.
+type Recorded = (&'static str, &'static [&'static str]);
+
+/// What the planner made of these prompts before it knew dataset v2 (recorded with `coma
+/// plan --json` and the v1 vocabulary, no sentence encoder).
+const PLANNED_BEFORE_V2: &[(&str, &[Recorded])] = &[
+    ("a person squats", &[("a person stands still", &["squat"])]),
+    (
+        "the man does three squats",
+        &[("a person stands still", &["squat"])],
+    ),
+    (
+        "someone jumps",
+        &[(
+            "a person stands still",
+            &["crouch to jump", "landing", "standing"],
+        )],
+    ),
+    (
+        "a person lies down on the floor",
+        &[("a person stands still", &["lie on the back"])],
+    ),
+    (
+        "she kicks with the left foot",
+        &[("a person kicks forward with a leg", &[])],
+    ),
+    (
+        "kicks a ball with the right foot",
+        &[("a person kicks forward with a leg", &[])],
+    ),
+    ("throws a ball", &[("throws a ball", &[])]),
+    (
+        "reaches up high with the left hand",
+        &[("a person stands still", &["stretching arms up"])],
+    ),
+    ("sneaks forward", &[("sneaks forward", &[])]),
+    (
+        "the girl squats while striking a T-pose, then walks forward waving the left hand",
+        &[
+            ("a person stands still", &["squat with T-pose"]),
+            ("a person walks forward", &[]),
+        ],
+    ),
+    (
+        "a person walks stealthily",
+        &[("a person walks forward", &[])],
+    ),
+    (
+        "a person does 3 kicks",
+        &[("a person kicks forward with a leg", &[])],
+    ),
+];
+
+#[test]
+fn without_dataset_v2_in_the_vocabulary_prompts_plan_as_before() {
+    let v1 = v1_vocabulary();
+    for (prompt, expected) in PLANNED_BEFORE_V2 {
+        let planned = plan_for(prompt, Some(&v1), None);
+        let got: Vec<(&str, Vec<&str>)> = planned
+            .segments
+            .iter()
+            .map(|s| {
+                let keys = s.postures.as_ref().map_or(Vec::new(), |t| {
+                    t.keys
+                        .iter()
+                        .filter_map(|k| k.script.name.as_deref())
+                        .collect()
+                });
+                (s.base.as_str(), keys)
+            })
+            .collect();
+        let expected: Vec<(&str, Vec<&str>)> =
+            expected.iter().map(|(b, k)| (*b, k.to_vec())).collect();
+        assert_eq!(got, expected, "{prompt:?}");
+        assert_eq!(planned, plan(prompt, None), "{prompt:?}");
+    }
+}
+
+#[test]
+fn a_dataset_action_needs_its_label_and_its_caption_words() {
+    let mut no_word = v2_vocabulary();
+    no_word.words.retain(|w| w != "squat");
+    let mut no_label = v2_vocabulary();
+    no_label.actions.remove("squat");
+    for vocabulary in [&no_word, &no_label] {
+        assert!(!Repertoire::new(Some(vocabulary)).knows(Action::Squat));
+        let planned = plan_for("a person squats", Some(vocabulary), None);
+        assert_eq!(planned.segments, plan("a person squats", None).segments);
+    }
+    // The rest of the repertoire is unaffected.
+    assert_eq!(
+        bases(&plan_for("someone jumps", Some(&no_word), None)),
+        ["a person jumps up"]
+    );
+    assert!(!Repertoire::new(None).knows_any());
+    assert!(!Repertoire::new(Some(&v1_vocabulary())).knows_any());
+}
