@@ -46,12 +46,16 @@ pub struct AgentFigures {
     pub circle: Option<CircleReport>,
 }
 
-/// The built-in planner over `prompts`, with `embed` mapping unknown movements.
+/// The built-in planner over `prompts` for the model whose training vocabulary is
+/// `vocabulary` (the actions it lists are planned with the model), with `embed` mapping
+/// unknown movements.
 pub fn planner_figures(
     prompts: &[prompt_set::SetPrompt],
+    vocabulary: Option<&crate::dataset::Vocabulary>,
     embed: Option<offline::Embedder>,
 ) -> PlannerFigures {
-    let report = prompt_set::score_prompts(prompts, &mut |p| offline::plan(p, embed));
+    let report =
+        prompt_set::score_prompts(prompts, &mut |p| offline::plan_for(p, vocabulary, embed));
     PlannerFigures {
         prompts: report.prompts,
         segment_rate: report.segment_rate,

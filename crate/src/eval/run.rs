@@ -59,7 +59,11 @@ pub fn evaluate_agents(
 ) -> Result<AgentFigures> {
     let prompts = crate::agents::planner::prompt_set::load(&options.prompts)?;
     let mut figures = AgentFigures {
-        planner: Some(planner_figures(&prompts, None)),
+        planner: Some(planner_figures(
+            &prompts,
+            session.and_then(Session::vocabulary),
+            None,
+        )),
         ..Default::default()
     };
     if let Some(session) = session {

@@ -540,9 +540,9 @@ fn decompose_messages(context: &str, segment: &str) -> Vec<Message> {
              EXPR, \"t0\": NUMBER, \"t1\": NUMBER}} on the ground (z is forward, x is the \
              person's left) where EXPR is arithmetic in t with + - * / ^, sin, cos, tan, abs, \
              sqrt, exp, log, min, max, pi and if(cond, a, b). Finally \"key_poses\": null, \
-             unless the segment asks for a pose or a movement the model does not make (a \
-             T-pose, a squat, kneeling, sitting or lying on the floor, a dab, a superhero \
-             landing); then a list of 1 to {max} key poses in time order, each {{\"name\": \
+             unless the segment asks for a pose held still or a movement that is not among \
+             the model's movements above (a T-pose, kneeling, sitting on the floor, a dab, a \
+             superhero landing, a deep squat held); then a list of 1 to {max} key poses in time order, each {{\"name\": \
              TEXT, \"hold\": SECONDS, \"constraints\": [...]}} with constraints from this \
              closed vocabulary:\n{vocabulary}\nReply in JSON with exactly these seven keys.",
             shapes = shape_names().join(", "),
