@@ -419,14 +419,7 @@ mod tests {
     fn set() -> MotionSet {
         let mut items: Vec<MotionItem> = (0..9).map(|_| item("walk", 100)).collect();
         items.push(item("squat", 100));
-        MotionSet {
-            items,
-            normalizer: Normalizer {
-                mean: vec![0.0; FEATURE_DIM],
-                std: vec![1.0; FEATURE_DIM],
-            },
-            cumulative: Vec::new(),
-        }
+        plain_set(items)
     }
 
     #[test]
@@ -447,6 +440,7 @@ mod tests {
         assert_eq!(set.action_shares(), plain);
     }
 
+    /// The items with identity normalisation, drawn in proportion to their length.
     fn plain_set(items: Vec<MotionItem>) -> MotionSet {
         MotionSet {
             items,
