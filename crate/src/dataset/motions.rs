@@ -133,15 +133,6 @@ pub struct CropDraw {
     pub real: usize,
 }
 
-/// Rows a motion of `len` rows has when played at `speed` (see [`features::retime`]).
-fn rows_at_speed(len: usize, speed: f64) -> usize {
-    if len == 0 {
-        0
-    } else {
-        ((len - 1) as f64 / speed + 1e-9).floor() as usize + 1
-    }
-}
-
 impl MotionSet {
     /// The item's joint positions (metres, Y up, 20 fps), from its features.
     pub fn joints(&self, item: &MotionItem) -> Vec<Pose> {
@@ -308,7 +299,7 @@ impl MotionSet {
             .collect();
         let longest = picks
             .iter()
-            .map(|&(i, s)| rows_at_speed(self.items[i].features.len(), s))
+            .map(|&(i, s)| features::retimed_rows(self.items[i].features.len(), s))
             .max()
             .unwrap_or(0);
         let multiple = spec.multiple.max(1);
@@ -317,10 +308,10 @@ impl MotionSet {
             .into_iter()
             .map(|(item, speed)| {
                 let len = self.items[item].features.len();
-                let rows = rows_at_speed(len, speed);
+                let rows = features::retimed_rows(len, speed);
                 if rows >= frames {
                     // Source rows that `frames` rows at this speed span.
-                    let span = (((frames - 1) as f64 * speed - 1e-9).ceil() as usize + 1).min(len);
+                    let span = features::source_rows(frames, speed).min(len);
                     let start = rng.below(len - span + 1);
                     CropDraw {
                         item,
@@ -373,9 +364,8 @@ impl MotionSet {
             let rows = if draw.speed == 1.0 {
                 item[draw.start..draw.start + draw.real].to_vec()
             } else {
-                let span = (((draw.real.max(1) - 1) as f64 * draw.speed - 1e-9).ceil() as usize
-                    + 1)
-                .min(item.len() - draw.start);
+                let span =
+                    features::source_rows(draw.real, draw.speed).min(item.len() - draw.start);
                 let window = self
                     .normalizer
                     .denormalize(&item[draw.start..draw.start + span]);

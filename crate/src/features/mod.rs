@@ -338,7 +338,7 @@ pub fn retime(features: &[FeatureFrame], speed: f64) -> Features {
         return Vec::new();
     }
     let last = features.len() - 1;
-    let rows = (last as f64 / speed + 1e-9).floor() as usize + 1;
+    let rows = retimed_rows(features.len(), speed);
     let scaled = |c: usize| {
         ROOT_ROT_VEL.contains(&c) || ROOT_LIN_VEL.contains(&c) || VELOCITIES.contains(&c)
     };
@@ -365,6 +365,20 @@ pub fn retime(features: &[FeatureFrame], speed: f64) -> Features {
             row
         })
         .collect()
+}
+
+/// Rows that [`retime`] makes of `rows` rows at `speed` (positive): `⌊(rows − 1) / speed⌋ + 1`.
+pub fn retimed_rows(rows: usize, speed: f64) -> usize {
+    match rows {
+        0 => 0,
+        _ => ((rows - 1) as f64 / speed + 1e-9).floor() as usize + 1,
+    }
+}
+
+/// Source rows that `rows` rows at `speed` span: the least `n` with
+/// `retimed_rows(n, speed) ≥ rows`.
+pub fn source_rows(rows: usize, speed: f64) -> usize {
+    ((rows.max(1) - 1) as f64 * speed - 1e-9).ceil() as usize + 1
 }
 
 /// Running sums over feature rows, to fit a [`Normalizer`] without keeping the rows.
