@@ -125,6 +125,26 @@ impl Split {
             Split::Test => "test.txt",
         }
     }
+
+    /// The split's name as command lines and reports spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Val => "val",
+            Split::Test => "test",
+        }
+    }
+}
+
+impl std::str::FromStr for Split {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Split, String> {
+        [Split::Train, Split::Val, Split::Test]
+            .into_iter()
+            .find(|split| split.name() == s)
+            .ok_or_else(|| format!("unknown split '{s}' (train, val or test)"))
+    }
 }
 
 /// What to build. Every source is optional; at least one must be given.
@@ -794,6 +814,17 @@ fn summarise(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn splits_parse_from_their_names_and_name_the_choices_otherwise() {
+        for split in [Split::Train, Split::Val, Split::Test] {
+            assert_eq!(split.name().parse::<Split>(), Ok(split));
+        }
+        assert_eq!(
+            "validation".parse::<Split>(),
+            Err("unknown split 'validation' (train, val or test)".to_string())
+        );
+    }
 
     #[test]
     fn windows_cover_long_clips_without_short_tails() {

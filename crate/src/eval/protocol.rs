@@ -144,8 +144,9 @@ pub enum Source<'a> {
     Real,
     /// The training motion whose caption is nearest (MiniLM cosine) to the test caption.
     Retrieval,
-    /// SPAM, generating a motion of the test motion's length from the caption.
-    Spam(&'a Spam),
+    /// SPAM, generating a motion of the test motion's length from the caption with these
+    /// sampling options (each motion's seed replaces theirs).
+    Spam(&'a Spam, &'a SamplingOptions),
     /// The same, then reviewed for up to `rounds` rounds by the loop of
     /// the engine ([`crate::session`]) with the evaluator as judge (no LLM): the caption is one
     /// segment. No multimodality (it would cost ten reviewed motions a caption). A reviewed
@@ -257,7 +258,7 @@ impl Protocol<'_> {
         let n = options.motions.min(captioned.len()) / BATCH * BATCH;
         anyhow::ensure!(
             n >= BATCH,
-            "the test split has {} captioned motions; the protocol needs at least {BATCH}",
+            "the measured split has {} captioned motions; the protocol needs at least {BATCH}",
             captioned.len()
         );
         let all: Vec<&[FeatureFrame]> = self
@@ -302,12 +303,12 @@ impl Protocol<'_> {
                             .map(|c| self.train.items[nearest[c]].features.as_slice())
                             .collect();
                     }
-                    Source::Spam(spam) => {
+                    Source::Spam(spam, sampling) => {
                         let generate = |sentence: &[f32; TEXT_DIM], frames: usize, seed: u64| {
                             block_on(async {
                                 let options = SamplingOptions {
                                     seed,
-                                    ..Default::default()
+                                    ..(*sampling).clone()
                                 };
                                 let text = part_text(sentence, &[]);
                                 let tokens = spam.generate(&text, frames.min(196), &options).await;

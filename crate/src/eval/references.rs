@@ -28,18 +28,26 @@ pub struct ActionReference {
 /// when none is labelled with it.
 pub fn action_reference(data: &Path, probe: &ActionProbe) -> Result<ActionReference> {
     let set = MotionSet::load(data, Split::Train)?;
-    let real = real_performances(&set, probe);
-    anyhow::ensure!(
-        !real.is_empty(),
-        "no training motion of {} is labelled {}",
-        data.display(),
-        probe.contents.join(" or ")
-    );
-    Ok(ActionReference {
-        motions: real.len(),
-        p10: quantile(real.clone(), 0.1),
-        median: quantile(real, 0.5),
+    ActionReference::of(&set, probe).ok_or_else(|| {
+        anyhow::anyhow!(
+            "no training motion of {} is labelled {}",
+            data.display(),
+            probe.contents.join(" or ")
+        )
     })
+}
+
+impl ActionReference {
+    /// The probe's measure over the motions of `set` that show its action; `None` when none
+    /// is labelled with it.
+    pub fn of(set: &MotionSet, probe: &ActionProbe) -> Option<ActionReference> {
+        let real = real_performances(set, probe);
+        (!real.is_empty()).then(|| ActionReference {
+            motions: real.len(),
+            p10: quantile(real.clone(), 0.1),
+            median: quantile(real, 0.5),
+        })
+    }
 }
 
 /// Every motion of `set` as joint positions (metres, Y up, 20 fps): the real motion whose

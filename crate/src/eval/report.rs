@@ -26,6 +26,34 @@ pub struct Probes {
     /// motion, m/s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub join_speeds: Option<JoinSpeeds>,
+    /// Share of left/right kicks where the asked ankle rises higher than the other.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub left_right_legs_rate: Option<f64>,
+    /// Per kick prompt: (prompt, correct, samples).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub left_right_legs: Vec<(String, usize, usize)>,
+    /// The action probes whose action the training split shows (squat, jump, …).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub actions: Vec<ActionFigure>,
+}
+
+/// How much of an action SPAM's motions perform against the training split's own
+/// performances of it, by one of [`super::probes::ACTIONS`].
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ActionFigure {
+    pub probe: String,
+    pub prompt: String,
+    /// What is measured, and its unit (metres, m/s, degrees).
+    pub measure: String,
+    pub unit: String,
+    pub real: super::references::ActionReference,
+    /// Median of the generated motions' measures.
+    pub median: f64,
+    /// Share of seeds whose motion reaches the real 10th percentile.
+    pub reaching: f64,
+    pub seeds: usize,
+    /// Length of each generated motion, seconds.
+    pub seconds: f64,
 }
 
 /// Speeds at a join against real motion.
@@ -46,7 +74,9 @@ pub struct EvalReport {
     pub evaluator_id: String,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spam_id: Option<String>,
-    /// Captioned motions in the test split.
+    /// The split measured (`test` for the report of record, `val` to tune on).
+    pub split: String,
+    /// Captioned motions in that split.
     pub test_motions: usize,
     pub options: ProtocolOptions,
     pub rows: BTreeMap<String, Row>,
@@ -96,7 +126,8 @@ impl EvalReport {
                 .map_or(String::new(), |id| format!(", SPAM model `{id}`"))
         );
         md.push_str(&format!(
-            "Protocol: the test split ({} captioned motions); per repetition {} motions, each with one of its captions drawn at random, R-precision in batches of 32, FID against all test motions, diversity over {} pairs, multimodality over {} captions × {} samples ({} pairs each); {} repetitions, mean ± 95 % interval. Embeddings are the evaluator's unit vectors, so distances lie in [0, 2].\n\n",
+            "Protocol: the {} split ({} captioned motions); per repetition {} motions, each with one of its captions drawn at random, R-precision in batches of 32, FID against all its motions, diversity over {} pairs, multimodality over {} captions × {} samples ({} pairs each); {} repetitions, mean ± 95 % interval. Embeddings are the evaluator's unit vectors, so distances lie in [0, 2].\n\n",
+            self.split,
             self.test_motions,
             o.motions.min(self.test_motions) / super::protocol::BATCH * super::protocol::BATCH,
             o.diversity_pairs,
@@ -151,6 +182,29 @@ impl EvalReport {
                 j.root, j.p99_root, j.joint, j.p99_joint
             ));
         }
+        if let Some(rate) = p.left_right_legs_rate {
+            md.push_str(&format!(
+                "| left/right: asked ankle rises higher | {:.1} % |\n",
+                rate * 100.0
+            ));
+            for (prompt, good, total) in &p.left_right_legs {
+                md.push_str(&format!("| &nbsp;&nbsp;\"{prompt}\" | {good}/{total} |\n"));
+            }
+        }
+        for a in &p.actions {
+            md.push_str(&format!(
+                "| \"{}\" ({} s, {} seeds): {} median (training motions' 10th percentile, median) | {:.2}{u} ({:.2}{u}, {:.2}{u}); {:.0} % of seeds reach the 10th percentile |\n",
+                a.prompt,
+                a.seconds,
+                a.seeds,
+                a.measure,
+                a.median,
+                a.real.p10,
+                a.real.median,
+                a.reaching * 100.0,
+                u = a.unit,
+            ));
+        }
         for name in ROW_ORDER {
             if let Some(row) = self.rows.get(name) {
                 md.push_str(&format!(
@@ -194,6 +248,7 @@ mod tests {
             command: "coma eval".into(),
             evaluator_id: "e".into(),
             spam_id: Some("s".into()),
+            split: "test".into(),
             test_motions: 300,
             options: ProtocolOptions::default(),
             rows: [("spam".into(), row(10)), ("spam_review".into(), row(3))].into(),
@@ -212,5 +267,50 @@ mod tests {
         assert!(line("spam_review").ends_with("(measured on the first 3 of the 10 repetitions)"));
         assert!(!line("spam").contains("measured on"));
         assert!(report.json().contains("\"repeats\": 3"));
+    }
+
+    #[test]
+    fn action_probes_and_kicks_show_their_bar_and_share() {
+        let probes = Probes {
+            left_right_legs_rate: Some(0.95),
+            left_right_legs: vec![("a person kicks with the left foot".into(), 19, 20)],
+            actions: vec![ActionFigure {
+                probe: "squat".into(),
+                prompt: "a person does a squat".into(),
+                measure: "pelvis drop".into(),
+                unit: " m".into(),
+                real: crate::eval::references::ActionReference {
+                    motions: 40,
+                    median: 0.42,
+                    p10: 0.3,
+                },
+                median: 0.35,
+                reaching: 0.7,
+                seeds: 20,
+                seconds: 4.0,
+            }],
+            ..Probes::default()
+        };
+        let report = EvalReport {
+            command: "coma eval".into(),
+            evaluator_id: "e".into(),
+            spam_id: Some("s".into()),
+            split: "test".into(),
+            test_motions: 300,
+            options: ProtocolOptions::default(),
+            rows: BTreeMap::new(),
+            probes,
+            agents: None,
+            agents_markdown: String::new(),
+            seconds: 1.0,
+        };
+        let md = report.markdown();
+        assert!(md.contains("| left/right: asked ankle rises higher | 95.0 % |"));
+        assert!(md.contains("| &nbsp;&nbsp;\"a person kicks with the left foot\" | 19/20 |"));
+        assert!(
+            md.contains("| \"a person does a squat\" (4 s, 20 seeds): pelvis drop median (training motions' 10th percentile, median) | 0.35 m (0.30 m, 0.42 m); 70 % of seeds reach the 10th percentile |"),
+            "{md}"
+        );
+        assert!(report.json().contains("\"reaching\": 0.7"));
     }
 }

@@ -3,13 +3,17 @@
 //! SPAM generates, and the agents' figures, gathered into one [`EvalReport`].
 
 use super::agents::{circle_probe, planner_figures, review_figures, AgentFigures};
-use super::probes::{edit_locality, left_right, LOCALITY_BASE, LOCALITY_EDIT, LOCALITY_SEEDS};
+use super::probes::{
+    action, edit_locality, left_right, left_right_legs, quantile, ACTIONS, LOCALITY_BASE,
+    LOCALITY_EDIT, LOCALITY_SEEDS,
+};
 use super::protocol::{Protocol, ProtocolOptions, Source};
-use super::references::walk_to_bow;
-use super::report::{EvalReport, JoinSpeeds, Probes};
+use super::references::{walk_to_bow, ActionReference};
+use super::report::{ActionFigure, EvalReport, JoinSpeeds, Probes};
 use crate::dataset::motions::MotionSet;
 use crate::dataset::Split;
 use crate::model::evaluator::Evaluator;
+use crate::model::generate::SamplingOptions;
 use crate::model::MotionModel;
 use crate::session::Session;
 use crate::text::minilm::SentenceEncoder;
@@ -36,9 +40,14 @@ pub struct EvalOptions<'a> {
     /// Folder with `evaluator.json`, `evaluator.bpk` and the sentence encoder: the
     /// text–motion evaluator that scores every motion.
     pub evaluator: &'a Path,
-    /// Dataset whose test split is measured (and whose training split the retrieval
-    /// baseline answers from).
+    /// Dataset whose `split` is measured (and whose training split the retrieval baseline
+    /// answers from).
     pub data: &'a Path,
+    /// The split measured: the test split for the report, the validation split to choose
+    /// sampling options without looking at the test motions.
+    pub split: Split,
+    /// How SPAM's rows sample (guidance, temperature, top-k); the seeds are the protocol's.
+    pub sampling: SamplingOptions,
     /// SPAM's model folder; without it only the real and retrieval rows and the planner are
     /// measured.
     pub spam: Option<&'a Path>,
@@ -82,6 +91,43 @@ pub fn evaluate_agents(
     Ok(figures)
 }
 
+/// Length of the probes' generated motions, seconds: long enough for one performance of
+/// every probed action (a squat, a jump, lying down) at the dataset's pace.
+const PROBE_SECONDS: f64 = 4.0;
+
+/// The action probes whose action `train` shows, each over `seeds` seeds at the default
+/// sampling options, against the training performances.
+fn action_figures(generator: &MotionModel, train: &MotionSet, seeds: u64) -> Vec<ActionFigure> {
+    let options = SamplingOptions::default();
+    ACTIONS
+        .iter()
+        .filter_map(|probe| {
+            let real = ActionReference::of(train, probe)?;
+            let report = action(
+                generator,
+                probe,
+                seeds,
+                PROBE_SECONDS,
+                &options,
+                &[options.base_guidance],
+                real.p10,
+            )
+            .pop()?;
+            Some(ActionFigure {
+                probe: probe.name.to_string(),
+                prompt: probe.prompt.to_string(),
+                measure: probe.measure_name.to_string(),
+                unit: probe.unit.to_string(),
+                median: quantile(report.values.clone(), 0.5),
+                reaching: report.reaching,
+                seeds: report.values.len(),
+                seconds: PROBE_SECONDS,
+                real,
+            })
+        })
+        .collect()
+}
+
 /// `coma eval`: the protocol's rows and the probes (with SPAM), and the agents' figures, as
 /// the report `EVAL.md` and `eval.json` are made from. Progress lines go to `log`.
 pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport> {
@@ -91,7 +137,7 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
     let evaluator_id =
         crate::model::model_id_of_dir(options.evaluator, &["evaluator.json", "evaluator.bpk"])?;
     let text = SentenceEncoder::from_dir(options.evaluator, &device)?;
-    let test = MotionSet::load(options.data, Split::Test)?;
+    let test = MotionSet::load(options.data, options.split)?;
     let train = MotionSet::load(options.data, Split::Train)?;
     let mut distinct: Vec<&str> = test
         .items
@@ -122,7 +168,7 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
     let agent_options = &options.agents;
     let mut sources = vec![("real", Source::Real), ("retrieval", Source::Retrieval)];
     if let (Some(session), Some(model)) = (&session, spam) {
-        sources.push(("spam", Source::Spam(&model.spam)));
+        sources.push(("spam", Source::Spam(&model.spam, &options.sampling)));
         if agent_options.review_rounds > 0 {
             sources.push((
                 "spam_review",
@@ -149,7 +195,7 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
         log(&format!(
             "probes: left/right over {probe_seeds} seeds a prompt"
         ));
-        let lr = left_right(generator, probe_seeds, 4.0);
+        let lr = left_right(generator, probe_seeds, PROBE_SECONDS);
         probes.left_right_rate = Some(lr.rate);
         probes.left_right = lr.prompts;
         let locality = edit_locality(generator, LOCALITY_BASE, LOCALITY_EDIT, 0..LOCALITY_SEEDS);
@@ -162,6 +208,13 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
             p99_root: join.p99_root_speed,
             p99_joint: join.p99_joint_speed,
         });
+        log(&format!(
+            "probes: left/right kicks and actions over {probe_seeds} seeds"
+        ));
+        let legs = left_right_legs(generator, probe_seeds, PROBE_SECONDS);
+        probes.left_right_legs_rate = Some(legs.rate);
+        probes.left_right_legs = legs.prompts;
+        probes.actions = action_figures(generator, &train, probe_seeds);
     }
     let agents = evaluate_agents(session.as_ref(), agent_options, log)?;
     Ok(EvalReport {
@@ -170,6 +223,7 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
         command: options.command.clone(),
         evaluator_id,
         spam_id: spam.map(|m| m.id.clone()),
+        split: options.split.name().to_string(),
         test_motions: test.items.iter().filter(|i| !i.captions.is_empty()).count(),
         options: options.protocol.clone(),
         rows,

@@ -5,6 +5,7 @@ use crate::common::ModelArgs;
 use anyhow::{Context, Result};
 use clap::Args;
 use coma::eval::run::{evaluate, AgentEvalOptions, EvalOptions};
+use coma::model::generate::SamplingOptions;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -14,6 +15,21 @@ pub struct EvalArgs {
     evaluator: PathBuf,
     #[arg(long, default_value = "data/bandai")]
     data: PathBuf,
+    /// The split measured: test for the report, val to choose sampling options without
+    /// looking at the test motions.
+    #[arg(long, default_value = "test")]
+    split: coma::dataset::Split,
+    /// Guidance scale of the base transformer in the spam row (the review loop and the probes
+    /// sample as the engine does).
+    #[arg(long, default_value_t = SamplingOptions::default().base_guidance)]
+    guidance: f32,
+    /// Softmax temperature of SPAM's sampling in the spam row (0 takes the most
+    /// likely code).
+    #[arg(long, default_value_t = SamplingOptions::default().temperature)]
+    temperature: f32,
+    /// Sample each code only among the K most likely in the spam row (default: all).
+    #[arg(long)]
+    top_k: Option<usize>,
     /// Repetitions (each with fresh captions and seeds).
     #[arg(long, default_value_t = 10)]
     repeats: usize,
@@ -57,6 +73,13 @@ pub fn run(args: EvalArgs) -> Result<()> {
     let options = EvalOptions {
         evaluator: &args.evaluator,
         data: &args.data,
+        split: args.split,
+        sampling: SamplingOptions {
+            base_guidance: args.guidance,
+            temperature: args.temperature,
+            top_k: args.top_k,
+            ..Default::default()
+        },
         spam: (!args.no_spam).then_some(args.model.models.as_path()),
         protocol: coma::eval::protocol::ProtocolOptions {
             repeats: args.repeats,

@@ -36,12 +36,7 @@ pub struct VqErrorArgs {
 }
 
 pub fn run(args: VqErrorArgs) -> Result<()> {
-    let split = match args.split.as_str() {
-        "train" => coma::dataset::Split::Train,
-        "val" => coma::dataset::Split::Val,
-        "test" => coma::dataset::Split::Test,
-        other => bail!("unknown split '{other}' (train, val or test)"),
-    };
+    let split: coma::dataset::Split = args.split.parse().map_err(anyhow::Error::msg)?;
     let cfg = <coma::train::vq::VqTrainingConfig as coma::train::ReadConfig>::read(&args.config)?;
     let device = burn::tensor::Device::flex();
     let model = coma::weights::load_file(cfg.model.init(&device), &args.weights)?;
