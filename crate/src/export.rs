@@ -352,8 +352,9 @@ pub fn export_random(sizes: &SpamConfig, data: &Path, out: &Path) -> Result<()> 
 }
 
 /// `coma export vocabulary`: the words and action labels of the training captions (the
-/// `vocabulary` of `data`'s `dataset.json`, with its licence), which the planner is told to
-/// describe motions with, written to `out/vocabulary.json`. Returns the number of words.
+/// `vocabulary` of `data`'s `dataset.json`, with its licence and each source's terms), which
+/// the planner is told to describe motions with and the page's About box credits, written to
+/// `out/vocabulary.json`. Returns the number of words.
 pub fn export_vocabulary(data: &Path, out: &Path) -> Result<usize> {
     let path = data.join("dataset.json");
     let summary: serde_json::Value = serde_json::from_str(
@@ -367,10 +368,63 @@ pub fn export_vocabulary(data: &Path, out: &Path) -> Result<usize> {
         path.display()
     );
     vocabulary["licence"] = summary["licence"].clone();
+    let terms: serde_json::Map<String, serde_json::Value> = summary["sources"]
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(name, source)| {
+            let terms = crate::dataset::DataTerms {
+                licence: source["licence"].as_str().unwrap_or_default().to_string(),
+                attribution: source["attribution"]
+                    .as_str()
+                    .unwrap_or_default()
+                    .to_string(),
+            };
+            (name.clone(), serde_json::json!(terms))
+        })
+        .collect();
+    vocabulary["sources"] = serde_json::Value::Object(terms);
     std::fs::create_dir_all(out)?;
     std::fs::write(
         out.join("vocabulary.json"),
         serde_json::to_string_pretty(&vocabulary)? + "\n",
     )?;
     Ok(vocabulary["words"].as_array().map_or(0, Vec::len))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dataset::{DataTerms, Vocabulary};
+
+    #[test]
+    fn the_vocabulary_carries_each_source_s_terms() {
+        let data = tempfile::tempdir().unwrap();
+        let summary = serde_json::json!({
+            "licence": "CC BY-NC 4.0; CC BY-SA 3.0",
+            "sources": {
+                "bandai": {"licence": "CC BY-NC 4.0", "attribution": "Bandai Namco", "frames": 9},
+                "hdm05": {"licence": "CC BY-SA 3.0", "attribution": "HDM05", "frames": 3},
+            },
+            "vocabulary": {"actions": {"squat": 4}, "styles": {}, "examples": {}, "words": ["squat"]},
+        });
+        std::fs::write(data.path().join("dataset.json"), summary.to_string()).unwrap();
+        let out = tempfile::tempdir().unwrap();
+        assert_eq!(export_vocabulary(data.path(), out.path()).unwrap(), 1);
+        let text = std::fs::read_to_string(out.path().join("vocabulary.json")).unwrap();
+        let vocabulary: Vocabulary = serde_json::from_str(&text).unwrap();
+        assert_eq!(
+            vocabulary.sources["hdm05"],
+            DataTerms {
+                licence: "CC BY-SA 3.0".into(),
+                attribution: "HDM05".into()
+            }
+        );
+        assert_eq!(vocabulary.sources.len(), 2);
+        // A vocabulary exported before sources were listed still reads, with none.
+        let old: Vocabulary =
+            serde_json::from_str(r#"{"actions": {}, "styles": {}, "examples": {}, "words": []}"#)
+                .unwrap();
+        assert!(old.sources.is_empty());
+    }
 }

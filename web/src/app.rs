@@ -29,6 +29,8 @@ pub struct ModelInfo {
     pub millis: f64,
     /// What did not load, and what the page does without it.
     pub missing: Vec<String>,
+    /// The motion data behind the weights, per source, and the terms they pass on.
+    pub training_data: std::collections::BTreeMap<String, coma::dataset::DataTerms>,
 }
 
 impl ModelInfo {
@@ -210,6 +212,7 @@ fn on_reply(state: AppState, reply: Reply) {
             bytes,
             millis,
             missing,
+            training_data,
         } => {
             state.progress.set(None);
             let info = ModelInfo {
@@ -220,6 +223,7 @@ fn on_reply(state: AppState, reply: Reply) {
                 bytes,
                 millis,
                 missing,
+                training_data,
             };
             state.say(format!(
                 "Model {} loaded ({:.1} MB in {:.1} s) on {}{}. Type a prompt and press Generate.",

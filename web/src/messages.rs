@@ -3,8 +3,10 @@
 //! the worker answers with the engine's [`Progress`] and [`Outcome`], so both sides share the
 //! library's types and nothing else.
 
+use coma::dataset::DataTerms;
 use coma::session::{Command, Outcome, Progress};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// A request from the page to the worker.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -103,6 +105,10 @@ pub enum Reply {
         /// vocabulary: the built-in planner only).
         #[serde(default)]
         missing: Vec<String>,
+        /// The motion data the weights were trained on, per source, with the terms the
+        /// weights inherit (from `vocabulary.json`; empty when it did not load).
+        #[serde(default)]
+        training_data: BTreeMap<String, DataTerms>,
     },
     /// The command in flight reports progress.
     Progress { progress: Progress },
@@ -189,6 +195,14 @@ mod tests {
             bytes: 10,
             millis: 1.5,
             missing: vec![],
+            training_data: [(
+                "hdm05".to_string(),
+                DataTerms {
+                    licence: "CC BY-SA 3.0".into(),
+                    attribution: "HDM05".into(),
+                },
+            )]
+            .into(),
         };
         assert_eq!(from_json::<Reply>(&to_json(&reply)).unwrap(), reply);
         let step = Reply::Progress {

@@ -268,6 +268,10 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
         serde_json::from_slice(&data).map_err(|e| format!("{VOCABULARY_FILE} does not read: {e}"))
     });
     let model_id = model.id.clone();
+    let training_data = vocabulary
+        .as_ref()
+        .map(|v: &coma::dataset::Vocabulary| v.sources.clone())
+        .unwrap_or_default();
     let (session, missing) = Session::new(model, evaluator, vocabulary);
     SESSION.with(|s| *s.borrow_mut() = Some(Rc::new(session)));
     Ok(Reply::Loaded {
@@ -278,6 +282,7 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
         bytes,
         millis: now() - started,
         missing,
+        training_data,
     })
 }
 

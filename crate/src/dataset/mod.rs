@@ -242,6 +242,20 @@ pub struct Vocabulary {
     pub examples: BTreeMap<String, String>,
     /// Every word used in captions and part sentences, sorted.
     pub words: Vec<String>,
+    /// The motion data behind the weights, per source (`bandai`, `hdm05`, …): the terms the
+    /// weights and the motions they generate inherit. `coma export vocabulary` fills it from
+    /// `dataset.json`; files exported before it was listed have none.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub sources: BTreeMap<String, DataTerms>,
+}
+
+/// A motion data source's terms as a model trained on it must pass them on.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DataTerms {
+    /// E.g. "CC BY-NC 4.0".
+    pub licence: String,
+    /// The credit line the licence asks for.
+    pub attribution: String,
 }
 
 /// Start and end (exclusive) joint frames of the windows a clip of `frames` joint frames is
@@ -806,6 +820,7 @@ fn summarise(
             styles,
             examples,
             words: words.into_iter().collect(),
+            sources: BTreeMap::new(),
         },
         items,
     }

@@ -198,19 +198,30 @@ pub fn train_transformer(
         .save(options.run_dir.join("config.json"))
         .map_err(|e| anyhow::anyhow!("saving config.json: {e}"))?;
     let init = options.init.as_deref();
-    let mut model = match kind {
-        Kind::Base => Model::Base(run.start_from(
-            BaseTransformer::new(&config.model, device),
-            init,
-            resumed,
-            progress,
-        )?),
-        Kind::Residual => Model::Residual(run.start_from(
-            ResidualTransformer::new(&config.model, device),
-            init,
-            resumed,
-            progress,
-        )?),
+    let fresh = || match kind {
+        Kind::Base => Model::Base(BaseTransformer::new(&config.model, device)),
+        Kind::Residual => Model::Residual(ResidualTransformer::new(&config.model, device)),
+    };
+    let started = match fresh() {
+        Model::Base(m) => run.start_from(m, init, resumed, progress).map(Model::Base),
+        Model::Residual(m) => run
+            .start_from(m, init, resumed, progress)
+            .map(Model::Residual),
+    };
+    let mut model = match (started, init) {
+        (Ok(model), _) => model,
+        // A checkpoint's model.bpk holds the network inside the loop's wrapper.
+        (Err(bare), Some(path)) => match crate::weights::load_file(fresh(), path) {
+            Ok(model) => {
+                progress(&format!(
+                    "starting from the checkpoint weights in {}",
+                    path.display()
+                ));
+                model
+            }
+            Err(_) => return Err(bare),
+        },
+        (Err(bare), None) => return Err(bare),
     };
     let mut optim = AdamWConfig::new()
         .with_weight_decay(1e-5)
@@ -457,6 +468,62 @@ mod tests {
                 .iter()
                 .any(|l| l.contains("accuracy")));
         }
+    }
+
+    /// A fresh run may start from another run's checkpoint (`checkpoint/model.bpk`, the
+    /// network inside the loop's wrapper) as well as from its final weights.
+    #[test]
+    fn a_run_starts_from_another_run_s_checkpoint_or_weights() {
+        let set = tiny_set();
+        let device = Device::flex().autodiff();
+        let first = tempfile::tempdir().unwrap();
+        let options = |dir: &std::path::Path, init: Option<PathBuf>| TransformerTrainOptions {
+            run_dir: dir.to_path_buf(),
+            minutes: None,
+            init,
+        };
+        train_transformer(
+            Kind::Base,
+            &config(),
+            &set,
+            &options(first.path(), None),
+            &device,
+            &|_| {},
+        )
+        .unwrap();
+        for (init, says) in [
+            (
+                "checkpoint/model.bpk",
+                "starting from the checkpoint weights",
+            ),
+            ("base.bpk", "starting from the weights"),
+        ] {
+            let second = tempfile::tempdir().unwrap();
+            let lines = std::sync::Mutex::new(Vec::new());
+            train_transformer(
+                Kind::Base,
+                &config(),
+                &set,
+                &options(second.path(), Some(first.path().join(init))),
+                &device,
+                &|l| lines.lock().unwrap().push(l.to_string()),
+            )
+            .unwrap_or_else(|e| panic!("starting from {init}: {e:#}"));
+            let lines = lines.into_inner().unwrap();
+            assert!(lines.iter().any(|l| l.starts_with(says)), "{lines:?}");
+        }
+        // Weights of the other network are refused with the first attempt's reason.
+        let third = tempfile::tempdir().unwrap();
+        let error = train_transformer(
+            Kind::Residual,
+            &config(),
+            &set,
+            &options(third.path(), Some(first.path().join("base.bpk"))),
+            &device,
+            &|_| {},
+        )
+        .unwrap_err();
+        assert!(format!("{error:#}").contains("base.bpk"), "{error:#}");
     }
 
     /// The residual transformer can learn a residual layer that is a function of the layers
