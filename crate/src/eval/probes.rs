@@ -326,7 +326,7 @@ pub const LEFT_WAVE: ActionProbe = ActionProbe {
     prompt: "a person waves the left hand",
     contents: &["wave-left-hand"],
     measure_name: "left-wrist speed about the pelvis",
-    unit: "m/s",
+    unit: " m/s",
     measure: left_wrist_speed,
 };
 

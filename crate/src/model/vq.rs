@@ -426,12 +426,40 @@ impl MotionVq {
     }
 
     /// Training pass: encode, quantize (with quantization dropout drawn from `rng`), decode
-    /// with straight-through gradients.
-    pub fn forward_train(&self, x: Tensor<3>, config: &VqConfig, rng: &mut Rng) -> VqTrainOutput {
+    /// with straight-through gradients. `real_frames` gives, per motion, how many of its
+    /// leading frames are its own (the rest pad a short clip by holding its last frame); the
+    /// commitment and the codebook averages then count only tokens that start on a real
+    /// frame, so padding's still poses do not pull the codes. `None`: every frame is real.
+    pub fn forward_train(
+        &self,
+        x: Tensor<3>,
+        real_frames: Option<&[usize]>,
+        config: &VqConfig,
+        rng: &mut Rng,
+    ) -> VqTrainOutput {
         let active = if (rng.uniform() as f64) < config.quantize_dropout {
             1 + rng.below(self.layers)
         } else {
             self.layers
+        };
+        let device = x.device();
+        let [_, frames, _] = x.dims();
+        // Rows are time-major within each motion (see `rows`); `None` when all are real.
+        let real_rows = real_frames
+            .filter(|real| real.iter().any(|&r| r < frames))
+            .map(|real| {
+                let n = frames / 4;
+                let rows: Vec<i32> = real
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(b, &r)| (0..n.min(r.div_ceil(4))).map(move |t| (b * n + t) as i32))
+                    .collect();
+                let len = rows.len();
+                Tensor::<1, Int>::from_data(TensorData::new(rows, [len]), &device)
+            });
+        let keep = |t: Tensor<2>| match &real_rows {
+            Some(rows) => t.select(0, rows.clone()),
+            None => t,
         };
         let mut parts = Vec::with_capacity(4);
         let mut commitment: Option<Tensor<1>> = None;
@@ -440,7 +468,17 @@ impl MotionVq {
             let [b, _, n] = z.dims();
             let rows = Self::rows(z);
             let (q, layers) = quantizer.quantize(rows.clone(), active);
-            let c = (rows.clone() - q.clone()).powi_scalar(2).mean();
+            let layers = layers
+                .into_iter()
+                .map(|a| LayerAssignment {
+                    residuals: keep(a.residuals),
+                    codes: match &real_rows {
+                        Some(rows) => a.codes.select(0, rows.clone()),
+                        None => a.codes,
+                    },
+                })
+                .collect();
+            let c = (keep(rows.clone()) - keep(q.clone())).powi_scalar(2).mean();
             commitment = Some(match commitment {
                 None => c,
                 Some(t) => t + c,
@@ -582,6 +620,30 @@ mod tests {
     }
 
     #[test]
+    fn padded_tokens_neither_commit_nor_move_the_codebooks() {
+        let device = Device::flex();
+        let config = small().with_quantize_dropout(0.0);
+        let vq = config.init(&device);
+        let x = motion(2, 16, &device);
+        let mut rng = Rng::new(5);
+        // Motion 0 is whole; motion 1 has 5 real frames: tokens 0 and 1 start on real frames.
+        let out = vq.forward_train(x.clone(), Some(&[16, 5]), &config, &mut rng);
+        for part in &out.assignments {
+            assert_eq!(part.len(), 3);
+            for layer in part {
+                assert_eq!(layer.codes.dims(), [4 + 2]);
+                assert_eq!(layer.residuals.dims(), [6, 8]);
+            }
+        }
+        assert_eq!(out.reconstruction.dims(), [2, 16, FEATURE_DIM]);
+        // Whole motions, said or not, quantize every token.
+        for real in [None, Some(&[16, 16][..])] {
+            let out = vq.forward_train(x.clone(), real, &config, &mut rng);
+            assert_eq!(out.assignments[0][0].codes.dims(), [8]);
+        }
+    }
+
+    #[test]
     fn training_step_reduces_the_loss_and_updates_codebooks() {
         let device = Device::flex().autodiff();
         let config = small();
@@ -609,6 +671,7 @@ mod tests {
         for _ in 0..40 {
             let out = vq.forward_train(
                 x.clone(),
+                None,
                 &config.clone().with_quantize_dropout(0.0),
                 &mut rng,
             );

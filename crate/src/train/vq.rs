@@ -199,9 +199,14 @@ pub fn train_vq(
         let crops = train.sample_crops(&mut rng, config.batch_size, &spec);
         let (b, t) = (crops.batch, crops.frames);
         let x = batch_tensor(crops.data, b, t, device);
+        let real_frames: Vec<usize> = crops
+            .mask
+            .chunks(t)
+            .map(|m| m.iter().filter(|&&v| v > 0.0).count())
+            .collect();
         let mask: Tensor<3> = Tensor::from_data(TensorData::new(crops.mask, [b, t, 1]), device);
 
-        let out = model.forward_train(x.clone(), &config.model, &mut rng);
+        let out = model.forward_train(x.clone(), Some(&real_frames), &config.model, &mut rng);
         // Means over the motions' own frames: padding that holds a short clip's last frame
         // is not the clip.
         let masked_mean = |loss: Tensor<3>, mask: Tensor<3>| {
