@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Remakes the figures under docs/ from the default model in static/models: the filmstrips of
-# the model issue's four prompts and of the agents' acceptance prompt (built-in planner, no
-# LLM), each from a fixed seed so anyone gets the same pictures.
+# the model issue's four prompts, of dataset v2's actions and of the agents' acceptance prompt
+# (built-in planner, no LLM), each from a fixed seed so anyone gets the same pictures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # COMA names an already built binary; by default cargo builds and runs it.
@@ -12,6 +12,12 @@ for prompt in "a person walks forward" "a person waves the left hand" \
   "a person raises the right hand" "a person bows"; do
   name="${prompt// /-}"
   "${coma[@]}" generate "$prompt" --seconds 6 --seed 1 --png "$out/$name.png"
+done
+# Dataset v2's actions, with the action probes' prompts and length (`coma probe squat|…`).
+for prompt in "a person does a squat" "a person jumps with both feet" \
+  "a person lies down on the floor" "a person kicks forward" "a person throws a ball"; do
+  name="${prompt// /-}"
+  "${coma[@]}" generate "$prompt" --seconds 4 --seed 1 --png "$out/$name.png"
 done
 "${coma[@]}" run "A person walks forward waving the left hand, then turns right and bows" \
   --seed 0 --png "$out/walk-wave-turn-bow.png" --json > "$out/walk-wave-turn-bow.json"

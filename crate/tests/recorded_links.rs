@@ -6,9 +6,9 @@
 //! A link is exact only for the model that made it (the page offers to regenerate a link of
 //! another model from its prompt), so when the shipped weights change the links are recorded
 //! again with the same example and the new model: in session 14 the weights became quantized
-//! (`crate/src/weights.rs`), and `v1.link`/`v2.link` were recorded again then. What they keep
-//! testing is that both link formats decode, through today's engine, to the joints the engine
-//! gave when they were recorded.
+//! (`crate/src/weights.rs`), and in session 18 the dataset v2 model shipped; `v1.link` and
+//! `v2.link` were recorded again both times. What they keep testing is that both link formats
+//! decode, through today's engine, to the joints the engine gave when they were recorded.
 //!
 //! Since issue 17 the engine puts every motion on the one reference skeleton
 //! ([`coma::skeleton::fixed_bones`]: bones keep their directions and get the reference

@@ -138,7 +138,7 @@ impl LlmArgs {
 #[derive(Args)]
 pub struct RunArgs {
     /// Dataset folder (from `coma data build`).
-    #[arg(long, default_value = "data/bandai")]
+    #[arg(long, default_value = "data/coma")]
     pub data: PathBuf,
     /// Run folder: checkpoints, logs, plots and the final weights (default: runs/<network>).
     #[arg(long)]

@@ -13,7 +13,7 @@ pub struct EvalArgs {
     /// Folder with evaluator.json and evaluator.bpk.
     #[arg(long, default_value = "static/models")]
     evaluator: PathBuf,
-    #[arg(long, default_value = "data/bandai")]
+    #[arg(long, default_value = "data/coma")]
     data: PathBuf,
     /// The split measured: test for the report, val to choose sampling options without
     /// looking at the test motions.

@@ -67,7 +67,7 @@ struct MotionsArgs {
     #[arg(long, default_value_t = coma::agents::pipeline::DEFAULT_ROUNDS)]
     rounds: usize,
     /// Dataset (from `coma data build`) whose test motions give the reference figures.
-    #[arg(long, default_value = "data/bandai")]
+    #[arg(long, default_value = "data/coma")]
     data: PathBuf,
     /// Folder of the model for the runs.
     #[arg(long, default_value = "static/models")]

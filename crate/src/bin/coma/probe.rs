@@ -34,7 +34,7 @@ struct ActionArgs {
     #[arg(long, default_value_t = coma::model::generate::SamplingOptions::default().temperature)]
     temperature: f32,
     /// Dataset whose training motions of the action are the reference.
-    #[arg(long, default_value = "data/bandai")]
+    #[arg(long, default_value = "data/coma")]
     data: PathBuf,
     #[command(flatten)]
     model: ModelArgs,
@@ -79,7 +79,7 @@ enum ProbeCommand {
     /// Blend two segments: speeds at the join against real motion's 99th percentile.
     Continuity {
         /// Dataset whose test motions give the reference speeds.
-        #[arg(long, default_value = "data/bandai")]
+        #[arg(long, default_value = "data/coma")]
         data: PathBuf,
         #[arg(long, default_value_t = 0)]
         seed: u64,

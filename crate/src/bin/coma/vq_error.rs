@@ -12,7 +12,7 @@ pub struct VqErrorArgs {
     /// The run's training configuration (for the sizes).
     #[arg(long, default_value = "configs/vq.json")]
     config: PathBuf,
-    #[arg(long, default_value = "data/bandai")]
+    #[arg(long, default_value = "data/coma")]
     data: PathBuf,
     /// train, val or test.
     #[arg(long, default_value = "test")]
