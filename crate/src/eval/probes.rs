@@ -462,13 +462,18 @@ pub const ACTIONS: [&ActionProbe; 7] = [&BOW, &LEFT_WAVE, &SQUAT, &JUMP, &LIE_DO
 pub fn real_performances(set: &MotionSet, probe: &ActionProbe) -> Vec<f64> {
     set.items
         .iter()
-        .filter(|i| {
-            i.content
-                .as_deref()
-                .is_some_and(|c| probe.contents.contains(&c))
-        })
+        .filter(|i| probe.shows(i))
         .map(|i| (probe.measure)(&set.joints(i)))
         .collect()
+}
+
+impl ActionProbe {
+    /// Whether a dataset motion is labelled with the probe's action.
+    pub fn shows(&self, item: &crate::dataset::motions::MotionItem) -> bool {
+        item.content
+            .as_deref()
+            .is_some_and(|c| self.contents.contains(&c))
+    }
 }
 
 /// Result of an action probe for one guidance scale.

@@ -8,6 +8,10 @@ use crate::dataset::motions::MotionSet;
 use crate::dataset::Split;
 use crate::model::MotionModel;
 use crate::skeleton::Pose;
+use crate::timing::FPS;
+
+/// Generation's time step, seconds (one token: 4 frames at 20 fps).
+const STEP_SECONDS: f64 = 0.2;
 use anyhow::Result;
 use std::path::Path;
 
@@ -22,6 +26,10 @@ pub struct ActionReference {
     /// 10th percentile of their measures: a generated motion that reaches it performs the
     /// action about as much as the dataset does.
     pub p10: f64,
+    /// Median length of those motions, seconds, on generation's 0.2 s grid (1 to 9.8 s): how
+    /// long a generated performance is asked to be. A kick takes under 2 s and lying down
+    /// about 6; a fixed length would ask for a kick held or a lying down cut short.
+    pub seconds: f64,
 }
 
 /// The probe's measure over the training motions of `data` that show its action; an error
@@ -42,10 +50,18 @@ impl ActionReference {
     /// is labelled with it.
     pub fn of(set: &MotionSet, probe: &ActionProbe) -> Option<ActionReference> {
         let real = real_performances(set, probe);
+        let frames: Vec<f64> = set
+            .items
+            .iter()
+            .filter(|i| probe.shows(i))
+            .map(|i| i.features.len() as f64)
+            .collect();
+        let step = 1.0 / STEP_SECONDS;
         (!real.is_empty()).then(|| ActionReference {
             motions: real.len(),
             p10: quantile(real.clone(), 0.1),
             median: quantile(real, 0.5),
+            seconds: ((quantile(frames, 0.5) / FPS * step).round() / step).clamp(1.0, 9.8),
         })
     }
 }

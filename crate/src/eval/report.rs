@@ -283,6 +283,7 @@ mod tests {
                     motions: 40,
                     median: 0.42,
                     p10: 0.3,
+                    seconds: 1.6,
                 },
                 median: 0.35,
                 reaching: 0.7,

@@ -91,12 +91,12 @@ pub fn evaluate_agents(
     Ok(figures)
 }
 
-/// Length of the probes' generated motions, seconds: long enough for one performance of
-/// every probed action (a squat, a jump, lying down) at the dataset's pace.
+/// Length of the left/right probes' generated motions, seconds: room for a raise, a wave or a
+/// kick and its return.
 const PROBE_SECONDS: f64 = 4.0;
 
 /// The action probes whose action `train` shows, each over `seeds` seeds at the default
-/// sampling options, against the training performances.
+/// sampling options and the training performances' median length, against them.
 fn action_figures(generator: &MotionModel, train: &MotionSet, seeds: u64) -> Vec<ActionFigure> {
     let options = SamplingOptions::default();
     ACTIONS
@@ -107,7 +107,7 @@ fn action_figures(generator: &MotionModel, train: &MotionSet, seeds: u64) -> Vec
                 generator,
                 probe,
                 seeds,
-                PROBE_SECONDS,
+                real.seconds,
                 &options,
                 &[options.base_guidance],
                 real.p10,
@@ -121,7 +121,7 @@ fn action_figures(generator: &MotionModel, train: &MotionSet, seeds: u64) -> Vec
                 median: quantile(report.values.clone(), 0.5),
                 reaching: report.reaching,
                 seeds: report.values.len(),
-                seconds: PROBE_SECONDS,
+                seconds: real.seconds,
                 real,
             })
         })

@@ -83,7 +83,8 @@ pub fn About() -> impl IntoView {
                 </ul>
                 <p>
                     "Output: a 22-joint SMPL skeleton at 20 fps, 1 to 9.8 s per generation. The model knows walking, running, "
-                    "waving and raising hands, bowing, kicking, punching and a few styles; see MODEL_CARD.md for its limits."
+                    "waving and raising hands, bowing, punching and a few styles of walking, and, less finely, squats, jumps, "
+                    "kicks, throws and the other actions of its smaller sources; see MODEL_CARD.md for its limits."
                 </p>
             </div>
         </details>

@@ -11,14 +11,16 @@ use leptos::prelude::*;
 const MAX_ROUNDS: usize = 4;
 
 /// Prompts the default model knows (its training vocabulary, see MODEL_CARD.md).
-pub const EXAMPLES: [&str; 8] = [
+pub const EXAMPLES: [&str; 10] = [
     "a person walks forward",
     "a person waves the left hand",
     "a person raises the right hand",
     "a person bows",
     "a person runs forward",
     "a person walks forward in a tired way",
-    "a person kicks",
+    "a person does a squat",
+    "a person jumps with both feet",
+    "a person kicks with the right foot",
     "a person walks backward",
 ];
 

@@ -21,9 +21,10 @@ pub struct ProbeArgs {
 struct ActionArgs {
     #[arg(long, default_value_t = 20)]
     seeds: u64,
-    /// Length of each generated motion in seconds.
-    #[arg(long, default_value_t = 4.0)]
-    seconds: f64,
+    /// Length of each generated motion in seconds (default: the median length of the
+    /// training motions that show the action, as `coma eval` asks).
+    #[arg(long)]
+    seconds: Option<f64>,
     /// Guidance scales of the base transformer to try (repeat for a sweep).
     #[arg(long, default_values_t = [coma::model::generate::SamplingOptions::default().base_guidance])]
     guidance: Vec<f32>,
@@ -161,12 +162,12 @@ pub fn run(args: ProbeArgs) -> Result<()> {
 /// Prints how much of an action the model performs over seeds and guidance scales, against
 /// the training motions that show it.
 fn action_probe(generator: &MotionModel, probe: &ActionProbe, args: ActionArgs) -> Result<()> {
-    anyhow::ensure!(
-        args.seconds > 0.0 && args.seconds.is_finite(),
-        "--seconds must be a positive number, not {}",
-        args.seconds
-    );
     let real = coma::eval::references::action_reference(&args.data, probe)?;
+    let seconds = args.seconds.unwrap_or(real.seconds);
+    anyhow::ensure!(
+        seconds > 0.0 && seconds.is_finite(),
+        "--seconds must be a positive number, not {seconds}"
+    );
     let (name, unit) = (probe.measure_name, probe.unit);
     let p10 = real.p10;
     println!(
@@ -188,7 +189,7 @@ fn action_probe(generator: &MotionModel, probe: &ActionProbe, args: ActionArgs) 
         generator,
         probe,
         args.seeds,
-        args.seconds,
+        seconds,
         &options,
         &args.guidance,
         p10,
@@ -196,7 +197,7 @@ fn action_probe(generator: &MotionModel, probe: &ActionProbe, args: ActionArgs) 
         println!(
             "\"{}\", {} s, guidance {}{sampling}: {name} median {:.2}{unit} over {} seeds, {:.0} % reach {p10:.2}{unit}",
             probe.prompt,
-            args.seconds,
+            seconds,
             r.guidance,
             quantile(r.values.clone(), 0.5),
             r.values.len(),
