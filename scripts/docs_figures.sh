@@ -13,11 +13,13 @@ for prompt in "a person walks forward" "a person waves the left hand" \
   name="${prompt// /-}"
   "${coma[@]}" generate "$prompt" --seconds 6 --seed 1 --png "$out/$name.png"
 done
-# Dataset v2's actions, with the action probes' prompts and length (`coma probe squat|…`).
-for prompt in "a person does a squat" "a person jumps with both feet" \
-  "a person lies down on the floor" "a person kicks forward" "a person throws a ball"; do
+# Dataset v2's actions, with the action probes' prompts and lengths (the median length of the
+# training motions that show each action: `coma probe squat|jump|lie-down|kick|throw`).
+for spec in "a person does a squat:1.4" "a person jumps with both feet:2.4" \
+  "a person lies down on the floor:5.8" "a person kicks forward:1.8" "a person throws a ball:3"; do
+  prompt="${spec%:*}"
   name="${prompt// /-}"
-  "${coma[@]}" generate "$prompt" --seconds 4 --seed 1 --png "$out/$name.png"
+  "${coma[@]}" generate "$prompt" --seconds "${spec##*:}" --seed 1 --png "$out/$name.png"
 done
 "${coma[@]}" run "A person walks forward waving the left hand, then turns right and bows" \
   --seed 0 --png "$out/walk-wave-turn-bow.png" --json > "$out/walk-wave-turn-bow.json"
