@@ -26,12 +26,9 @@ pub struct Probes {
     /// motion, m/s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub join_speeds: Option<JoinSpeeds>,
-    /// Share of left/right kicks where the asked ankle rises higher than the other.
+    /// Left/right kicks: how often the asked ankle rises higher than the other.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub left_right_legs_rate: Option<f64>,
-    /// Per kick prompt: (prompt, correct, samples).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub left_right_legs: Vec<(String, usize, usize)>,
+    pub left_right_legs: Option<super::probes::LeftRightReport>,
     /// The action probes whose action the training split shows (squat, jump, …).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub actions: Vec<ActionFigure>,
@@ -155,14 +152,15 @@ impl EvalReport {
         }
         md.push_str("\n## Control probes\n\n| probe | figure |\n|---|---|\n");
         let p = &self.probes;
-        if let Some(rate) = p.left_right_rate {
-            md.push_str(&format!(
-                "| left/right: asked wrist ends higher | {:.1} % |\n",
-                rate * 100.0
-            ));
-            for (prompt, good, total) in &p.left_right {
+        // One line for the rate, one per prompt.
+        let sided = |md: &mut String, what: &str, rate: f64, rows: &[(String, usize, usize)]| {
+            md.push_str(&format!("| left/right: {what} | {:.1} % |\n", rate * 100.0));
+            for (prompt, good, total) in rows {
                 md.push_str(&format!("| &nbsp;&nbsp;\"{prompt}\" | {good}/{total} |\n"));
             }
+        };
+        if let Some(rate) = p.left_right_rate {
+            sided(&mut md, "asked wrist ends higher", rate, &p.left_right);
         }
         if let Some(cm) = p.edit_leg_change_cm {
             md.push_str(&format!(
@@ -182,14 +180,13 @@ impl EvalReport {
                 j.root, j.p99_root, j.joint, j.p99_joint
             ));
         }
-        if let Some(rate) = p.left_right_legs_rate {
-            md.push_str(&format!(
-                "| left/right: asked ankle rises higher | {:.1} % |\n",
-                rate * 100.0
-            ));
-            for (prompt, good, total) in &p.left_right_legs {
-                md.push_str(&format!("| &nbsp;&nbsp;\"{prompt}\" | {good}/{total} |\n"));
-            }
+        if let Some(legs) = &p.left_right_legs {
+            sided(
+                &mut md,
+                "asked ankle rises higher",
+                legs.rate,
+                &legs.prompts,
+            );
         }
         for a in &p.actions {
             md.push_str(&format!(
@@ -242,21 +239,28 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_row_measured_on_fewer_repetitions_says_so() {
-        let report = EvalReport {
+    fn report(rows: BTreeMap<String, Row>, probes: Probes) -> EvalReport {
+        EvalReport {
             command: "coma eval".into(),
             evaluator_id: "e".into(),
             spam_id: Some("s".into()),
             split: "test".into(),
             test_motions: 300,
             options: ProtocolOptions::default(),
-            rows: [("spam".into(), row(10)), ("spam_review".into(), row(3))].into(),
-            probes: Probes::default(),
+            rows,
+            probes,
             agents: None,
             agents_markdown: String::new(),
             seconds: 1.0,
-        };
+        }
+    }
+
+    #[test]
+    fn a_row_measured_on_fewer_repetitions_says_so() {
+        let report = report(
+            [("spam".into(), row(10)), ("spam_review".into(), row(3))].into(),
+            Probes::default(),
+        );
         let md = report.markdown();
         let line = |name: &str| {
             md.lines()
@@ -272,8 +276,10 @@ mod tests {
     #[test]
     fn action_probes_and_kicks_show_their_bar_and_share() {
         let probes = Probes {
-            left_right_legs_rate: Some(0.95),
-            left_right_legs: vec![("a person kicks with the left foot".into(), 19, 20)],
+            left_right_legs: Some(crate::eval::probes::LeftRightReport {
+                prompts: vec![("a person kicks with the left foot".into(), 19, 20)],
+                rate: 0.95,
+            }),
             actions: vec![ActionFigure {
                 probe: "squat".into(),
                 prompt: "a person does a squat".into(),
@@ -292,19 +298,7 @@ mod tests {
             }],
             ..Probes::default()
         };
-        let report = EvalReport {
-            command: "coma eval".into(),
-            evaluator_id: "e".into(),
-            spam_id: Some("s".into()),
-            split: "test".into(),
-            test_motions: 300,
-            options: ProtocolOptions::default(),
-            rows: BTreeMap::new(),
-            probes,
-            agents: None,
-            agents_markdown: String::new(),
-            seconds: 1.0,
-        };
+        let report = report(BTreeMap::new(), probes);
         let md = report.markdown();
         assert!(md.contains("| left/right: asked ankle rises higher | 95.0 % |"));
         assert!(md.contains("| &nbsp;&nbsp;\"a person kicks with the left foot\" | 19/20 |"));

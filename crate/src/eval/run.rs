@@ -211,9 +211,7 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
         log(&format!(
             "probes: left/right kicks and actions over {probe_seeds} seeds"
         ));
-        let legs = left_right_legs(generator, probe_seeds, PROBE_SECONDS);
-        probes.left_right_legs_rate = Some(legs.rate);
-        probes.left_right_legs = legs.prompts;
+        probes.left_right_legs = Some(left_right_legs(generator, probe_seeds, PROBE_SECONDS));
         probes.actions = action_figures(generator, &train, probe_seeds);
     }
     let agents = evaluate_agents(session.as_ref(), agent_options, log)?;
