@@ -9,11 +9,11 @@ use crate::dataset::Split;
 use crate::model::MotionModel;
 use crate::skeleton::Pose;
 use crate::timing::FPS;
+use anyhow::Result;
+use std::path::Path;
 
 /// Generation's time step, seconds (one token: 4 frames at 20 fps).
 const STEP_SECONDS: f64 = 0.2;
-use anyhow::Result;
-use std::path::Path;
 
 /// How much of an action the dataset's own performances show, by the probe's measure (in
 /// its unit): the bar generated motions of the action's prompt are held to.
