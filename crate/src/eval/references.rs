@@ -3,7 +3,7 @@
 //! frame-to-frame speeds bound how fast a blend's join may be (`coma probe continuity`,
 //! `coma eval`).
 
-use super::probes::{continuity, quantile, real_performances, ActionProbe, ContinuityReport};
+use super::probes::{continuity, quantile, ActionProbe, ContinuityReport};
 use crate::dataset::motions::MotionSet;
 use crate::dataset::Split;
 use crate::model::MotionModel;
@@ -49,13 +49,12 @@ impl ActionReference {
     /// The probe's measure over the motions of `set` that show its action; `None` when none
     /// is labelled with it.
     pub fn of(set: &MotionSet, probe: &ActionProbe) -> Option<ActionReference> {
-        let real = real_performances(set, probe);
-        let frames: Vec<f64> = set
+        let (real, frames): (Vec<f64>, Vec<f64>) = set
             .items
             .iter()
             .filter(|i| probe.shows(i))
-            .map(|i| i.features.len() as f64)
-            .collect();
+            .map(|i| ((probe.measure)(&set.joints(i)), i.features.len() as f64))
+            .unzip();
         let step = 1.0 / STEP_SECONDS;
         (!real.is_empty()).then(|| ActionReference {
             motions: real.len(),
