@@ -11,8 +11,9 @@ use crate::executor::block_on;
 use crate::features::FeatureFrame;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
 use crate::model::generate::SamplingOptions;
+use crate::model::prior::{MotionPrior, PriorOptions};
 use crate::model::transformer::PARTS;
-use crate::model::{Spam, SpamConfig, SpamFiles, RESIDUAL_FILE};
+use crate::model::{Spam, SpamConfig, SpamFiles, PRIOR_FILE, RESIDUAL_FILE};
 use crate::quant::Bits;
 use crate::text::minilm::SentenceEncoder;
 use crate::train::evaluator::EvaluatorTrainingConfig;
@@ -118,6 +119,7 @@ pub fn export_spam(
         residual: res_bytes.as_deref(),
         mean: &mean,
         std: &std,
+        prior: None,
     };
     let (full, _) = Spam::from_bytes(&files, &device)?;
 
@@ -131,14 +133,17 @@ pub fn export_spam(
         &shipped_bytes(&full.vq, &|name| vq_bits(name, bits), &[])?,
     )?;
     write("base.bpk", &shipped_bytes(&full.base, &|_| bits, &[])?)?;
+    // A stale residual file, or a prior of another VQ-VAE's tokens, would make the folder
+    // fail to load; `coma export prior` adds the prior back.
+    let remove = |name: &str| match std::fs::remove_file(out.join(name)) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
+    };
     match &full.residual {
         Some(r) => write(RESIDUAL_FILE, &shipped_bytes(&r.network, &|_| bits, &[])?)?,
-        // A stale residual file would make the folder fail to load.
-        None => match std::fs::remove_file(out.join(RESIDUAL_FILE)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e)?,
-            _ => {}
-        },
+        None => remove(RESIDUAL_FILE)?,
     }
+    remove(PRIOR_FILE)?;
     write("mean.npy", &mean)?;
     write("std.npy", &std)?;
     let (shipped, _, id) = Spam::load(out, &device)?;
@@ -318,6 +323,125 @@ impl ExportedEvaluator {
             &device,
         ))
     }
+}
+
+/// A retrieval prior added to a model folder.
+#[derive(Debug)]
+pub struct ExportedPrior {
+    /// Distinct training captions and training motions it holds.
+    pub captions: usize,
+    pub motions: usize,
+    /// Bytes of `prior.bin`.
+    pub bytes: u64,
+    /// The folder's model id after the change (see [`crate::model::model_id`]).
+    pub id: String,
+}
+
+/// `coma export prior`: the retrieval prior (see [`crate::model::prior`]) of the training
+/// motions of `data` (at most `per_action` of each action), tokenized by the VQ-VAE run `vq`
+/// (the f32 weights the transformers learnt from), with their captions embedded by the sentence encoder in `out`, written to
+/// `out/prior.bin`; `out/spam.json` gets `options` as the model's default. The folder must
+/// hold the model made from that VQ-VAE (`coma export spam` first), and is loaded back.
+pub fn export_prior(
+    vq: &Path,
+    data: &Path,
+    out: &Path,
+    options: PriorOptions,
+    per_action: usize,
+    progress: &dyn Fn(&str),
+) -> Result<ExportedPrior> {
+    let device = Device::flex();
+    let vq_config = <VqTrainingConfig as crate::train::ReadConfig>::read(&vq.join("config.json"))?;
+    let network = crate::weights::load_file(vq_config.model.init(&device), &vq.join("vq.bpk"))
+        .context("cannot load the VQ-VAE")?;
+    let spam_json = out.join("spam.json");
+    let mut sizes = SpamConfig::load(&spam_json)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", spam_json.display()))?;
+    anyhow::ensure!(
+        sizes.vq.codebook_size == vq_config.model.codebook_size,
+        "{} holds a model with {} codes per layer, the VQ-VAE {} has {}",
+        out.display(),
+        sizes.vq.codebook_size,
+        vq.display(),
+        vq_config.model.codebook_size
+    );
+    let text = SentenceEncoder::from_dir(out, &device)?;
+    let train = MotionSet::load(data, Split::Train)?;
+    let tokens = crate::train::tokens::TokenSet::build(
+        &train,
+        &network,
+        &device,
+        &|t| Ok(text.encode(t)),
+        progress,
+    )?;
+    let kept = kept_per_action(&tokens, per_action);
+    // One key per caption with its subject said plainly: the subject words say nothing about
+    // the motion, and each key is most of the file.
+    let mut described: std::collections::BTreeMap<String, Vec<u32>> = Default::default();
+    for (m, item) in kept.iter().map(|i| &tokens.items[*i]).enumerate() {
+        for c in &item.captions {
+            let motions = described
+                .entry(crate::dataset::captions::with_plain_subject(
+                    &tokens.texts[*c],
+                ))
+                .or_default();
+            if motions.last() != Some(&(m as u32)) {
+                motions.push(m as u32);
+            }
+        }
+    }
+    let texts: Vec<&str> = described.keys().map(String::as_str).collect();
+    let mut embeddings = Vec::with_capacity(texts.len());
+    for chunk in texts.chunks(64) {
+        embeddings.extend(text.encode(chunk));
+    }
+    let captions: Vec<_> = embeddings
+        .into_iter()
+        .zip(described.into_values())
+        .collect();
+    let motions = kept
+        .iter()
+        .map(|i| std::array::from_fn(|p| tokens.items[*i].tokens[p][0].clone()))
+        .collect();
+    let prior = MotionPrior::new(&captions, motions);
+    let bytes = prior.to_bytes();
+    std::fs::write(out.join(PRIOR_FILE), &bytes)
+        .with_context(|| out.join(PRIOR_FILE).display().to_string())?;
+    sizes.prior = Some(options);
+    std::fs::write(&spam_json, serde_json::to_string_pretty(&sizes)?)
+        .with_context(|| spam_json.display().to_string())?;
+    let (_, _, id) = Spam::load(out, &device)?;
+    let (captions, motions) = prior.len();
+    Ok(ExportedPrior {
+        captions,
+        motions,
+        bytes: bytes.len() as u64,
+        id,
+    })
+}
+
+/// Indices of at most `per_action` items of each action (unlabelled items counted as one
+/// action), drawn with a fixed seed, in their original order: every action stays, and the
+/// hundreds of walks and raised hands do not fill the page's download.
+fn kept_per_action(tokens: &crate::train::tokens::TokenSet, per_action: usize) -> Vec<usize> {
+    let mut by_action: std::collections::BTreeMap<Option<&str>, Vec<usize>> = Default::default();
+    for (i, item) in tokens.items.iter().enumerate() {
+        by_action
+            .entry(item.content.as_deref())
+            .or_default()
+            .push(i);
+    }
+    let mut rng = crate::rng::Rng::new(0x5052_494f_52);
+    let mut kept: Vec<usize> = by_action
+        .into_values()
+        .flat_map(|mut items| {
+            rng.shuffle(&mut items);
+            items.truncate(per_action);
+            items
+        })
+        .collect();
+    kept.sort_unstable();
+    kept
 }
 
 /// `coma export random`: SPAM with random weights at `sizes` and the feature statistics of

@@ -12,7 +12,7 @@ use coma::agents::llm::LlmClient;
 use coma::model::evaluator::Evaluator;
 use coma::model::guidance::GuidancePartner;
 use coma::model::motion_model::TextFiles;
-use coma::model::{MotionModel, SpamConfig, SpamFiles, RESIDUAL_FILE};
+use coma::model::{MotionModel, SpamConfig, SpamFiles, PRIOR_FILE, RESIDUAL_FILE};
 use coma::session::{Command, Session, VOCABULARY_FILE};
 use coma::text::minilm::{MODEL_FILE, VOCAB_FILE, WORDS_FILE};
 use std::cell::RefCell;
@@ -244,6 +244,7 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
             residual: files.get(RESIDUAL_FILE).map(Vec::as_slice),
             mean: file("mean.npy"),
             std: file("std.npy"),
+            prior: files.get(PRIOR_FILE).map(Vec::as_slice),
         },
         &TextFiles {
             vocab: text(VOCAB_FILE)?,

@@ -442,6 +442,15 @@ fn style_words(style: &str) -> Option<(&'static [&'static str], &'static str)> {
 
 const SUBJECTS: [&str; 4] = ["a person", "someone", "the person", "a human"];
 
+/// The caption with its subject ("someone", "a human", …, the words [`global_captions`]
+/// varies) said as "a person": captions that differ only there describe the same motion.
+pub fn with_plain_subject(caption: &str) -> String {
+    SUBJECTS
+        .iter()
+        .find_map(|s| caption.strip_prefix(s)?.strip_prefix(' '))
+        .map_or_else(|| caption.to_string(), |rest| format!("a person {rest}"))
+}
+
 /// A small deterministic hash so every clip gets its own but reproducible choice of words.
 pub fn stable_hash(text: &str) -> u64 {
     text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
@@ -495,6 +504,21 @@ pub fn global_captions(content: &str, style: &str, seed: &str, count: usize) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn subjects_become_a_person_and_the_rest_stays() {
+        assert_eq!(with_plain_subject("someone waves"), "a person waves");
+        assert_eq!(
+            with_plain_subject("a human jumps high"),
+            "a person jumps high"
+        );
+        assert_eq!(with_plain_subject("a person bows"), "a person bows");
+        assert_eq!(
+            with_plain_subject("an old person bows"),
+            "an old person bows"
+        );
+        assert_eq!(with_plain_subject("someoneX waves"), "someoneX waves");
+    }
 
     #[test]
     fn mirroring_swaps_sides() {

@@ -73,6 +73,10 @@ pub struct EvalReport {
     pub spam_id: Option<String>,
     /// The split measured (`test` for the report of record, `val` to tune on).
     pub split: String,
+    /// How SPAM's rows used its retrieval prior; absent when the model has none or it was
+    /// turned off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub prior: Option<crate::model::prior::PriorOptions>,
     /// Captioned motions in that split.
     pub test_motions: usize,
     pub options: ProtocolOptions,
@@ -149,6 +153,17 @@ impl EvalReport {
                 String::new()
             };
             md.push_str(&format!("- **{name}**: {}{part}\n", describe(name)));
+        }
+        if let Some(prior) = &self.prior {
+            md.push_str(&format!(
+                "\nSPAM starts each motion from its retrieval prior (the training split's \
+                 motions, never this split's): it keeps {:.0} % of the tokens of a training \
+                 motion whose caption is within {} of the nearest one's cosine similarity, \
+                 when that is at least {}.\n",
+                prior.keep * 100.0,
+                prior.margin,
+                prior.min_similarity
+            ));
         }
         md.push_str("\n## Control probes\n\n| probe | figure |\n|---|---|\n");
         let p = &self.probes;
@@ -245,6 +260,7 @@ mod tests {
             evaluator_id: "e".into(),
             spam_id: Some("s".into()),
             split: "test".into(),
+            prior: None,
             test_motions: 300,
             options: ProtocolOptions::default(),
             rows,

@@ -222,6 +222,10 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
         evaluator_id,
         spam_id: spam.map(|m| m.id.clone()),
         split: options.split.name().to_string(),
+        prior: spam
+            .and_then(|m| m.spam.prior.as_ref())
+            .map(|p| options.sampling.prior.unwrap_or(p.options))
+            .filter(|p| p.keep > 0.0),
         test_motions: test.items.iter().filter(|i| !i.captions.is_empty()).count(),
         options: options.protocol.clone(),
         rows,

@@ -81,15 +81,62 @@ impl Spam {
         self.generate_steps(text, n, options).await
     }
 
-    /// A new motion of exactly `n` time steps.
+    /// A new motion of exactly `n` time steps: from the text alone, or from a training
+    /// motion near it when the model has a retrieval prior (see [`Spam::prior_tokens`]).
     async fn generate_steps(
         &self,
         text: &PartText,
         n: usize,
         options: &SamplingOptions,
     ) -> MotionTokens {
-        self.fill(text, None, &vec![vec![true; n]; PARTS], options)
-            .await
+        match self.prior_tokens(text, n, options) {
+            None => {
+                self.fill(text, None, &vec![vec![true; n]; PARTS], options)
+                    .await
+            }
+            Some(fixed) => {
+                let mut rng = Rng::new(options.seed);
+                let base = self.decode_base(text, &fixed, options, &mut rng).await;
+                self.decode_residual(text, base, None, options, &mut rng)
+                    .await
+            }
+        }
+    }
+
+    /// The layer-0 tokens a new motion of `n` steps keeps from the retrieval prior: for each
+    /// part, the training motion nearest its text (drawn by the seed among equally near
+    /// ones), aligned at its start, with a random `keep` share of its steps kept and the
+    /// rest (and any steps past its end) left to the transformer. `None` when the model has
+    /// no prior, it is turned off, or no part's text is near a training caption.
+    fn prior_tokens(
+        &self,
+        text: &PartText,
+        n: usize,
+        options: &SamplingOptions,
+    ) -> Option<Vec<Vec<Option<u32>>>> {
+        let prior = self.prior.as_ref()?;
+        let settings = options.prior.unwrap_or(prior.options);
+        if settings.keep <= 0.0 {
+            return None;
+        }
+        // Its own stream, so that a model without a prior samples what it always did.
+        let mut rng = Rng::new(options.seed ^ 0x5052_494f_5221);
+        let mut found = false;
+        let fixed = text
+            .iter()
+            .enumerate()
+            .map(|(p, t)| {
+                let motion = prior.motions.nearest(t, &settings, &mut rng);
+                found |= motion.is_some();
+                (0..n)
+                    .map(|s| {
+                        let code = motion.and_then(|m| m[p].get(s).copied());
+                        code.filter(|_| rng.uniform() < settings.keep)
+                    })
+                    .collect()
+            })
+            .collect();
+        found.then_some(fixed)
     }
 
     /// Regenerates frames `from..to` of every part.
@@ -260,6 +307,57 @@ mod tests {
                     "asked {frames}, got {got}"
                 );
             }
+        })
+    }
+
+    #[test]
+    fn a_prior_seeds_new_motions_and_keep_zero_turns_it_off() {
+        use crate::model::prior::{MotionPrior, PriorOptions};
+        use crate::model::Prior;
+        block_on(async {
+            let mut s = spam();
+            let near = [0.05f32; TEXT_DIM];
+            let mut far = [0.0f32; TEXT_DIM];
+            far[0] = 1.0;
+            let without = s.generate(&[near; PARTS], 40, &seeded(4)).await;
+            // One training motion of 6 steps whose every code is 9, under a caption that is
+            // the prompt itself.
+            s.prior = Some(Prior {
+                motions: MotionPrior::new(
+                    &[(near, vec![0])],
+                    vec![std::array::from_fn(|_| vec![9; 6])],
+                ),
+                options: PriorOptions {
+                    keep: 0.5,
+                    ..Default::default()
+                },
+            });
+            let with = s.generate(&[near; PARTS], 40, &seeded(4)).await;
+            let nines = |t: &MotionTokens| -> usize {
+                (0..PARTS)
+                    .map(|p| t[p][0][..6].iter().filter(|c| **c == 9).count())
+                    .sum()
+            };
+            // About half of the 24 prior positions are kept; random codes of 16 rarely hit 9.
+            assert!(nines(&with) >= 6, "{} nines in {with:?}", nines(&with));
+            assert!(nines(&with) > nines(&without) + 3);
+            let off = SamplingOptions {
+                prior: Some(PriorOptions {
+                    keep: 0.0,
+                    ..Default::default()
+                }),
+                ..seeded(4)
+            };
+            assert_eq!(s.generate(&[near; PARTS], 40, &off).await, without);
+            // A prompt far from every caption gets no prior.
+            let text = [far; PARTS];
+            let plain = {
+                let prior = s.prior.take();
+                let t = s.generate(&text, 40, &seeded(4)).await;
+                s.prior = prior;
+                t
+            };
+            assert_eq!(s.generate(&text, 40, &seeded(4)).await, plain);
         })
     }
 

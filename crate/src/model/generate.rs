@@ -3,6 +3,7 @@
 //! seed gives the same motion on every backend.
 
 use super::guidance::{Pass, PassInputs};
+use super::prior::PriorOptions;
 use super::transformer::{PARTS, TEXT_DIM};
 use super::{Residual, Spam};
 use crate::rng::Rng;
@@ -20,6 +21,9 @@ pub struct SamplingOptions {
     pub temperature: f32,
     /// Sample only among the `k` most likely codes.
     pub top_k: Option<usize>,
+    /// How a new motion uses the model's retrieval prior; `None` takes the model's own
+    /// options (`spam.json`), and a `keep` of 0 generates from the text alone.
+    pub prior: Option<PriorOptions>,
     pub seed: u64,
 }
 
@@ -34,6 +38,7 @@ impl Default for SamplingOptions {
             residual_guidance: 5.0,
             temperature: 1.0,
             top_k: None,
+            prior: None,
             seed: 0,
         }
     }

@@ -10,11 +10,13 @@ pub mod gelu;
 pub mod generate;
 pub mod guidance;
 pub mod motion_model;
+pub mod prior;
 pub mod tokens;
 pub mod transformer;
 pub mod vq;
 
 pub use motion_model::MotionModel;
+use prior::{MotionPrior, PriorOptions};
 use transformer::{BaseTransformer, ResidualTransformer, TransformerConfig};
 use vq::{MotionVq, VqConfig};
 
@@ -42,10 +44,20 @@ pub struct Spam {
     /// Absent in a base-only model, whose motions decode from the layer-0 tokens alone
     /// (coarser: see MODEL_CARD.md for the reconstruction error of one layer).
     pub residual: Option<Residual>,
+    /// Training motions that new motions start from (see [`prior`]); `None` generates from
+    /// the text alone.
+    pub prior: Option<Prior>,
     pub device: Device,
     /// Where guidance's unconditional pass runs besides here (the page's second worker);
     /// `None` runs both passes on this device (see [`guidance`]).
     pub partner: Option<std::rc::Rc<dyn guidance::GuidancePartner>>,
+}
+
+/// The retrieval prior and how generation uses it by default.
+#[derive(Debug)]
+pub struct Prior {
+    pub motions: MotionPrior,
+    pub options: PriorOptions,
 }
 
 /// The residual transformer and its sizes.
@@ -73,6 +85,7 @@ impl Spam {
                 network: ResidualTransformer::new(config, device),
                 config: config.clone(),
             }),
+            prior: None,
             device: device.clone(),
             partner: None,
         }
@@ -89,37 +102,45 @@ impl Spam {
 }
 
 /// Sizes of SPAM's networks, stored beside their weights as `spam.json`. A model without a
-/// residual transformer (`"residual": null`) is base-only.
+/// residual transformer (`"residual": null`) is base-only; one with `prior` options has a
+/// retrieval prior ([`PRIOR_FILE`]) and generates with those options by default.
 #[derive(Config, Debug)]
 pub struct SpamConfig {
     pub vq: VqConfig,
     pub base: TransformerConfig,
     pub residual: Option<TransformerConfig>,
+    pub prior: Option<PriorOptions>,
 }
 
 impl SpamConfig {
     /// The model folder's files for these sizes, in the order its id hashes them: every one
-    /// of [`WEIGHT_FILES`] but `residual.bpk` for a base-only model.
+    /// of [`WEIGHT_FILES`] but `residual.bpk` for a base-only model and `prior.bin` for one
+    /// without a retrieval prior.
     pub fn weight_files(&self) -> Vec<&'static str> {
         WEIGHT_FILES
             .into_iter()
             .filter(|f| *f != RESIDUAL_FILE || self.residual.is_some())
+            .filter(|f| *f != PRIOR_FILE || self.prior.is_some())
             .collect()
     }
 }
 
 /// Every weight file a SPAM model folder may hold, in the order its id hashes them.
-pub const WEIGHT_FILES: [&str; 6] = [
+pub const WEIGHT_FILES: [&str; 7] = [
     "spam.json",
     "vq.bpk",
     "base.bpk",
     RESIDUAL_FILE,
     "mean.npy",
     "std.npy",
+    PRIOR_FILE,
 ];
 
 /// The residual transformer's weights: the one file a base-only model lacks.
 pub const RESIDUAL_FILE: &str = "residual.bpk";
+
+/// The retrieval prior (see [`prior`]), in a model whose `spam.json` has `prior` options.
+pub const PRIOR_FILE: &str = "prior.bin";
 
 /// A model's id: the first 16 hex digits of the SHA-256 of its weight files, in
 /// [`SpamConfig::weight_files`] order. Share links name the model they were made with by this id.
@@ -169,6 +190,8 @@ pub struct SpamFiles<'a> {
     pub residual: Option<&'a [u8]>,
     pub mean: &'a [u8],
     pub std: &'a [u8],
+    /// `None` for a model without a retrieval prior.
+    pub prior: Option<&'a [u8]>,
 }
 
 impl SpamFiles<'_> {
@@ -177,6 +200,7 @@ impl SpamFiles<'_> {
         let mut files: Vec<&[u8]> = vec![self.config.as_bytes(), self.vq, self.base];
         files.extend(self.residual);
         files.extend([self.mean, self.std]);
+        files.extend(self.prior);
         model_id(&files)
     }
 }
@@ -194,6 +218,29 @@ impl Spam {
             crate::weights::load_into(spam.vq, files.vq).map_err(|e| file_error("vq.bpk", e))?;
         let normalizer = crate::features::Normalizer::from_npy_bytes(files.mean, files.std)
             .map_err(|e| file_error("mean.npy/std.npy", e.to_string()))?;
+        let options = serde_json::from_str::<SpamConfig>(files.config)
+            .map_err(|e| file_error("spam.json", e.to_string()))?
+            .prior;
+        spam.prior = match (options, files.prior) {
+            (Some(options), Some(bytes)) => Some(Prior {
+                motions: MotionPrior::from_bytes(bytes, spam.base_config.codebook_size)
+                    .map_err(|e| file_error(PRIOR_FILE, e.to_string()))?,
+                options,
+            }),
+            (Some(_), None) => {
+                return Err(file_error(
+                    PRIOR_FILE,
+                    "missing, but spam.json has prior options".into(),
+                ))
+            }
+            (None, Some(_)) => {
+                return Err(file_error(
+                    PRIOR_FILE,
+                    "present, but spam.json has no prior options (\"prior\": null)".into(),
+                ))
+            }
+            (None, None) => None,
+        };
         Ok((spam, normalizer))
     }
 
@@ -246,10 +293,15 @@ impl Spam {
         let config_bytes = read("spam.json")?;
         let config = std::str::from_utf8(&config_bytes)
             .map_err(|e| load_error(&dir.join("spam.json"), e))?;
-        let residual = match serde_json::from_str::<SpamConfig>(config) {
-            Ok(sizes) if sizes.residual.is_none() => None,
-            // A damaged spam.json is reported by `from_bytes`.
+        // A damaged spam.json is reported by `from_bytes`.
+        let sizes = serde_json::from_str::<SpamConfig>(config).ok();
+        let residual = match &sizes {
+            Some(sizes) if sizes.residual.is_none() => None,
             _ => Some(read(RESIDUAL_FILE)?),
+        };
+        let prior = match &sizes {
+            Some(sizes) if sizes.prior.is_some() => Some(read(PRIOR_FILE)?),
+            _ => None,
         };
         let (vq, base) = (read("vq.bpk")?, read("base.bpk")?);
         let (mean, std) = (read("mean.npy")?, read("std.npy")?);
@@ -260,6 +312,7 @@ impl Spam {
             residual: residual.as_deref(),
             mean: &mean,
             std: &std,
+            prior: prior.as_deref(),
         };
         let (spam, normalizer) =
             Spam::from_bytes(&files, device).map_err(|SpamLoadError::File { file, message }| {

@@ -8,7 +8,7 @@ use crate::dataset::motions::{CropSpec, MotionSet};
 use crate::dataset::Split;
 use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM, POSITIONS, ROOT_ROT_VEL};
 use crate::geom;
-use crate::model::vq::{MotionVq, VqConfig};
+use crate::model::vq::{MotionVq, VqConfig, VqTrainOutput};
 use crate::rng::Rng;
 use crate::timing::FRAMES_PER_TOKEN;
 use anyhow::{Context, Result};
@@ -66,6 +66,11 @@ pub struct VqTrainingConfig {
     /// integrates into a drifting heading that turns the whole body. 0 leaves it out.
     #[config(default = 0.0)]
     pub heading_weight: f64,
+    /// Above 0, trains the decoder alone for motions decoded from this many token layers:
+    /// the encoder and the codebooks stay as `--init` gave them, so every token stays the
+    /// same and transformers trained on them still fit. 0 trains everything.
+    #[config(default = 0)]
+    pub decoder_only_layers: usize,
     #[config(default = 5.0)]
     pub checkpoint_minutes: f64,
     /// Steps between progress lines.
@@ -206,7 +211,16 @@ pub fn train_vq(
             .collect();
         let mask: Tensor<3> = Tensor::from_data(TensorData::new(crops.mask, [b, t, 1]), device);
 
-        let out = model.forward_train(x.clone(), Some(&real_frames), &config.model, &mut rng);
+        let decoder_only = config.decoder_only_layers;
+        let out = if decoder_only > 0 {
+            VqTrainOutput {
+                reconstruction: model.forward_decoder_train(x.clone(), decoder_only),
+                commitment: Tensor::zeros([1], device),
+                assignments: Vec::new(),
+            }
+        } else {
+            model.forward_train(x.clone(), Some(&real_frames), &config.model, &mut rng)
+        };
         // Means over the motions' own frames: padding that holds a short clip's last frame
         // is not the clip.
         let masked_mean = |loss: Tensor<3>, mask: Tensor<3>| {
@@ -250,9 +264,18 @@ pub fn train_vq(
             out.commitment.clone().into_scalar::<f32>() as f64,
             heading.into_scalar::<f32>() as f64,
         ];
-        let grads = GradientsParams::from_grads(loss.backward(), &model);
+        let mut gradients = loss.backward();
+        let grads = if decoder_only > 0 {
+            GradientsParams::from_module(&mut gradients, model.decoder())
+        } else {
+            GradientsParams::from_grads(gradients, &model)
+        };
         model = optim.step(learning_rate(config, step), model, grads);
-        let reset = model.update_codebooks(&out.assignments, config.model.ema_decay, &mut rng);
+        let reset = if decoder_only > 0 {
+            0
+        } else {
+            model.update_codebooks(&out.assignments, config.model.ema_decay, &mut rng)
+        };
         let logged = [values[0], values[1], values[2], values[3], reset as f64];
         run.record(crops.batch, &logged)?;
 
@@ -267,7 +290,10 @@ pub fn train_vq(
                 val,
                 &device.clone().without_autodiff(),
                 64,
-                usize::MAX,
+                match config.decoder_only_layers {
+                    0 => usize::MAX,
+                    layers => layers,
+                },
             )?;
             progress(&format!(
                 "step {done}: validation reconstruction error {:.1} mm root-aligned MPJPE, {:.1} mm with the root path integrated, {:.1} mm posture",

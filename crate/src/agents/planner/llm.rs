@@ -40,7 +40,7 @@ pub async fn plan<T: Transport>(
 ) -> Plan {
     let mut notes = Vec::new();
     let offline_plan = offline::plan_for(prompt, Some(vocabulary), embed);
-    let context = vocabulary_brief(vocabulary);
+    let context = vocabulary_brief(vocabulary, BRIEF_CHARS);
 
     // The text the later steps read: the LLM's rewrite, or the user's prompt itself when the
     // rewrite failed (the built-in rules read the prompt better than their own rewrite).
@@ -474,22 +474,56 @@ fn trajectory_from_reply(value: Value) -> Result<Trajectory, String> {
     Ok(trajectory)
 }
 
-/// What the motion model knows, for the rewrite and decompose questions: its actions with an
-/// example caption each, its styles and its caption words.
-pub fn vocabulary_brief(vocabulary: &Vocabulary) -> String {
-    let actions: Vec<String> = vocabulary
-        .examples
-        .iter()
-        .map(|(action, example)| format!("- {action}: \"{example}\""))
-        .collect();
+/// Characters the vocabulary brief may take. Small local models have 2,048-token contexts
+/// (CI's SmolLM2-135M among them) and English runs about 4 characters a token; the decompose
+/// question's own instructions and posture vocabulary take about 3,900 characters, so this
+/// leaves room for the segment and the reply.
+pub const BRIEF_CHARS: usize = 2_400;
+
+/// What the motion model knows, for the rewrite and decompose questions, in at most `budget`
+/// characters: its actions (a left/right pair as one, `kick-{left|right}-leg`) and styles
+/// always; then example captions, one per action, while they fit; then every word of its
+/// captions if all of them fit.
+pub fn vocabulary_brief(vocabulary: &Vocabulary, budget: usize) -> String {
+    let mut actions: Vec<(String, &str)> = Vec::new();
+    for (action, example) in &vocabulary.examples {
+        let sided = action
+            .split('-')
+            .map(|w| match w {
+                "left" | "right" => "{left|right}",
+                w => w,
+            })
+            .collect::<Vec<_>>()
+            .join("-");
+        if !actions.iter().any(|(a, _)| *a == sided) {
+            actions.push((sided, example));
+        }
+    }
+    let names: Vec<&str> = actions.iter().map(|(a, _)| a.as_str()).collect();
     let styles: Vec<&str> = vocabulary.styles.keys().map(String::as_str).collect();
-    format!(
-        "Movements the motion model was trained on, each with an example caption:\n{}\n\
-         Styles it knows: {}.\nWords of its captions: {}.",
-        actions.join("\n"),
-        styles.join(", "),
-        vocabulary.words.join(" ")
-    )
+    let mut brief = format!(
+        "Movements the motion model was trained on: {}.\nStyles it knows: {}.",
+        names.join(", "),
+        styles.join(", ")
+    );
+    let mut examples = Vec::new();
+    let mut room = budget.saturating_sub(brief.len() + 40);
+    for (_, example) in &actions {
+        let line = format!("\"{example}\"");
+        if line.len() + 2 > room {
+            break;
+        }
+        room -= line.len() + 2;
+        examples.push(line);
+    }
+    if !examples.is_empty() {
+        brief += &format!("\nExample captions: {}.", examples.join("; "));
+    }
+    let words = vocabulary.words.join(" ");
+    if brief.len() + words.len() + 30 <= budget {
+        brief += &format!("\nWords of its captions: {words}.");
+    }
+    brief
 }
 
 fn rewrite_messages(context: &str, prompt: &str) -> Vec<Message> {

@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use coma::eval::run::{evaluate, AgentEvalOptions, EvalOptions};
 use coma::model::generate::SamplingOptions;
+use coma::model::prior::PriorOptions;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -30,6 +31,14 @@ pub struct EvalArgs {
     /// Sample each code only among the K most likely in the spam row (default: all).
     #[arg(long)]
     top_k: Option<usize>,
+    /// Share of the retrieved training motion's tokens that the spam row's motions keep
+    /// (0 generates from the text alone); without it, the model's own setting (spam.json).
+    #[arg(long)]
+    prior_keep: Option<f32>,
+    /// Least caption similarity for the retrieval prior to apply in the spam row, with
+    /// --prior-keep.
+    #[arg(long, default_value_t = PriorOptions::default().min_similarity, requires = "prior_keep")]
+    prior_min_similarity: f32,
     /// Repetitions (each with fresh captions and seeds).
     #[arg(long, default_value_t = 10)]
     repeats: usize,
@@ -78,6 +87,11 @@ pub fn run(args: EvalArgs) -> Result<()> {
             base_guidance: args.guidance,
             temperature: args.temperature,
             top_k: args.top_k,
+            prior: args.prior_keep.map(|keep| PriorOptions {
+                keep,
+                min_similarity: args.prior_min_similarity,
+                ..Default::default()
+            }),
             ..Default::default()
         },
         spam: (!args.no_spam).then_some(args.model.models.as_path()),

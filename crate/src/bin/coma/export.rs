@@ -4,6 +4,7 @@
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use coma::export::{self, EvaluatorRounding};
+use coma::model::prior::PriorOptions;
 use coma::quant::Bits;
 use std::path::PathBuf;
 
@@ -35,6 +36,17 @@ pub struct ExportArgs {
     /// without it every float is rounded to f16.
     #[arg(long, value_parser = ["4", "8"])]
     bits: Option<String>,
+    /// Share of a retrieved training motion's tokens a new motion keeps (prior).
+    #[arg(long, default_value_t = PriorOptions::default().keep)]
+    prior_keep: f32,
+    /// Least cosine similarity between a prompt and a training caption for the prior to
+    /// apply (prior).
+    #[arg(long, default_value_t = PriorOptions::default().min_similarity)]
+    prior_min_similarity: f32,
+    /// Most training motions of one action the prior holds (prior): the rare actions keep
+    /// all theirs, and the download stays small.
+    #[arg(long, default_value_t = 24)]
+    prior_per_action: usize,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -49,6 +61,9 @@ enum ExportWhat {
     /// The words and action labels of the training captions (from the dataset's
     /// dataset.json), which the planner is told to use.
     Vocabulary,
+    /// The retrieval prior: the training motions of --data as tokens of the --vq run, indexed
+    /// by their captions, added to the model in --out (after `coma export spam`).
+    Prior,
 }
 
 pub fn run(args: ExportArgs) -> Result<()> {
@@ -61,6 +76,9 @@ pub fn run(args: ExportArgs) -> Result<()> {
         data,
         out,
         bits,
+        prior_keep,
+        prior_min_similarity,
+        prior_per_action,
     } = args;
     let bits = bits.map(|b| if b == "4" { Bits::Four } else { Bits::Eight });
     let precision = match bits {
@@ -75,6 +93,24 @@ pub fn run(args: ExportArgs) -> Result<()> {
                 .map_err(|e| anyhow::anyhow!("configs/spam.json: {e}"))?;
             export::export_random(&sizes, &data, &out)?;
             println!("wrote SPAM with random weights into {}", out.display());
+        }
+        ExportWhat::Prior => {
+            let options = PriorOptions {
+                keep: prior_keep,
+                min_similarity: prior_min_similarity,
+                ..Default::default()
+            };
+            let p = export::export_prior(&vq, &data, &out, options, prior_per_action, &|l| {
+                eprintln!("{l}")
+            })?;
+            println!(
+                "wrote the retrieval prior into {}: {} training motions under {} distinct captions, {} bytes; model id {}",
+                out.display(),
+                p.motions,
+                p.captions,
+                p.bytes,
+                p.id
+            );
         }
         ExportWhat::Vocabulary => {
             let words = export::export_vocabulary(&data, &out)?;

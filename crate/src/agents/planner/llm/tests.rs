@@ -244,3 +244,55 @@ fn key_poses_from_the_llm_are_checked_and_a_bad_one_is_retried_with_its_error() 
         "the retry names the wrong constraint: {last}"
     );
 }
+
+#[test]
+fn the_questions_fit_a_small_model_s_context_with_the_shipped_vocabulary() {
+    let vocabulary = vocabulary();
+    let brief = vocabulary_brief(&vocabulary, BRIEF_CHARS);
+    assert!(brief.len() <= BRIEF_CHARS, "{} characters", brief.len());
+    assert!(brief.contains("kick-{left|right}-leg"), "{brief}");
+    assert!(
+        brief.contains("squat") && brief.contains("lie-down"),
+        "{brief}"
+    );
+    assert!(brief.contains("Example captions: \""), "{brief}");
+    // 2,048 tokens at about 4 characters each, less room for the segment and the reply.
+    let longest = |messages: Vec<Message>| {
+        messages
+            .iter()
+            .flat_map(|m| &m.content)
+            .map(|c| match c {
+                crate::agents::llm::ContentPart::Text(t) => t.len(),
+                crate::agents::llm::ContentPart::ImageUrl(u) => u.len(),
+            })
+            .sum::<usize>()
+    };
+    let segment = "a person walks forward waving the left hand while turning right slowly";
+    for (question, chars) in [
+        ("rewrite", longest(rewrite_messages(&brief, PROMPT))),
+        ("segment", longest(segment_messages(PROMPT))),
+        ("decompose", longest(decompose_messages(&brief, segment))),
+    ] {
+        assert!(
+            chars <= 6_600,
+            "the {question} question takes {chars} characters"
+        );
+    }
+}
+
+#[test]
+fn a_small_budget_keeps_the_actions_and_drops_the_examples_first() {
+    let vocabulary = vocabulary();
+    let full = vocabulary_brief(&vocabulary, 100_000);
+    assert!(full.contains("Words of its captions:") && full.contains("Example captions:"));
+    let small = vocabulary_brief(&vocabulary, 0);
+    assert!(small.contains("Movements the motion model was trained on: "));
+    assert!(!small.contains("Example captions") && !small.contains("Words of"));
+    for action in vocabulary
+        .actions
+        .keys()
+        .filter(|a| !a.contains("left") && !a.contains("right"))
+    {
+        assert!(small.contains(action.as_str()), "{action} missing");
+    }
+}
