@@ -431,7 +431,7 @@ fn kept_per_action(tokens: &crate::train::tokens::TokenSet, per_action: usize) -
             .or_default()
             .push(i);
     }
-    let mut rng = crate::rng::Rng::new(0x5052_494f_52);
+    let mut rng = crate::rng::Rng::new(0x0050_5249_4f52);
     let mut kept: Vec<usize> = by_action
         .into_values()
         .flat_map(|mut items| {

@@ -105,8 +105,9 @@ impl Spam {
 
     /// The layer-0 tokens a new motion of `n` steps keeps from the retrieval prior: for each
     /// part, the training motion nearest its text (drawn by the seed among equally near
-    /// ones), aligned at its start, with a random `keep` share of its steps kept and the
-    /// rest (and any steps past its end) left to the transformer. `None` when the model has
+    /// ones of about that length; parts with the same text share it), stretched to `n` steps,
+    /// with a random `keep` share of its steps kept in every part and the rest left to the
+    /// transformer. `None` when the model has
     /// no prior, it is turned off, or no part's text is near a training caption.
     fn prior_tokens(
         &self,
@@ -121,17 +122,26 @@ impl Spam {
         }
         // Its own stream, so that a model without a prior samples what it always did.
         let mut rng = Rng::new(options.seed ^ 0x5052_494f_5221);
-        let mut found = false;
+        // Parts that share a text share one training motion, and every part keeps the same
+        // steps: whole-body key poses of one motion, which a mix of motions would not be.
+        let mut chosen: Vec<(&[f32; TEXT_DIM], Option<&[Vec<u32>; PARTS]>)> = Vec::new();
+        for t in text {
+            if !chosen.iter().any(|(c, _)| *c == t) {
+                chosen.push((t, prior.motions.nearest(t, n, &settings, &mut rng)));
+            }
+        }
+        let kept: Vec<bool> = (0..n).map(|_| rng.uniform() < settings.keep).collect();
+        let found = chosen.iter().any(|(_, m)| m.is_some());
         let fixed = text
             .iter()
             .enumerate()
             .map(|(p, t)| {
-                let motion = prior.motions.nearest(t, &settings, &mut rng);
-                found |= motion.is_some();
+                let motion = chosen.iter().find(|(c, _)| *c == t).and_then(|(_, m)| *m);
                 (0..n)
                     .map(|s| {
-                        let code = motion.and_then(|m| m[p].get(s).copied());
-                        code.filter(|_| rng.uniform() < settings.keep)
+                        // Stretched to the asked length (within about a quarter of it).
+                        let code = motion.map(|m| m[p][s * m[p].len() / n]);
+                        code.filter(|_| kept[s])
                     })
                     .collect()
             })

@@ -279,10 +279,13 @@ impl MotionPrior {
 
     /// The tokens `[part][step]` of a training motion whose caption is nearest `text` (cosine
     /// similarity, at least `options.min_similarity`), drawn with `rng` among the motions of
-    /// every caption within `options.margin` of the nearest; `None` when no caption is near.
+    /// every caption within `options.margin` of the nearest, and among those the ones closest
+    /// to `steps` long (within a quarter of it, or the closest if none is); `None` when no
+    /// caption is near.
     pub fn nearest(
         &self,
         text: &[f32; TEXT_DIM],
+        steps: usize,
         options: &PriorOptions,
         rng: &mut Rng,
     ) -> Option<&[Vec<u32>; PARTS]> {
@@ -316,6 +319,15 @@ impl MotionPrior {
             .collect();
         candidates.sort_unstable();
         candidates.dedup();
+        // A motion cut short or stretched far does not do what its caption says in the time
+        // asked (a lie-down cut at 5.8 s of 8 is still going down).
+        let misfit = |m: &u32| {
+            (self.motions[*m as usize][0].len() as f32 / steps.max(1) as f32)
+                .ln()
+                .abs()
+        };
+        let closest = candidates.iter().map(misfit).fold(f32::INFINITY, f32::min);
+        candidates.retain(|m| misfit(m) <= closest.max(1.25f32.ln()));
         Some(&self.motions[candidates[rng.below(candidates.len())] as usize])
     }
 }
@@ -347,8 +359,21 @@ mod tests {
         near[1] = 0.1;
         MotionPrior::new(
             &[(unit(0), vec![0, 1]), (near, vec![2]), (unit(5), vec![3])],
-            vec![motion(1, 3), motion(10, 4), motion(20, 2), motion(300, 5)],
+            vec![motion(1, 3), motion(10, 3), motion(20, 3), motion(300, 5)],
         )
+    }
+
+    #[test]
+    fn motions_near_the_asked_length_are_preferred() {
+        let prior = MotionPrior::new(&[(unit(0), vec![0, 1])], vec![motion(1, 4), motion(2, 12)]);
+        let options = PriorOptions::default();
+        let mut rng = Rng::new(2);
+        for (steps, code) in [(5, 1), (10, 2), (40, 2), (1, 1)] {
+            for _ in 0..20 {
+                let m = prior.nearest(&unit(0), steps, &options, &mut rng).unwrap();
+                assert_eq!(m[0][0], code, "{steps} steps");
+            }
+        }
     }
 
     #[test]
@@ -396,7 +421,7 @@ mod tests {
         let mut rng = Rng::new(1);
         let mut seen = std::collections::BTreeSet::new();
         for _ in 0..100 {
-            let m = prior.nearest(&unit(0), &options, &mut rng).unwrap();
+            let m = prior.nearest(&unit(0), 3, &options, &mut rng).unwrap();
             seen.insert(m[0][0]);
         }
         // Motions 0 and 1 belong to the caption itself; motion 2's caption is 0.995 similar,
@@ -407,16 +432,16 @@ mod tests {
             ..options
         };
         for _ in 0..50 {
-            let m = prior.nearest(&unit(0), &strict, &mut rng).unwrap();
+            let m = prior.nearest(&unit(0), 3, &strict, &mut rng).unwrap();
             assert!(m[0][0] == 1 || m[0][0] == 10);
         }
         assert_eq!(
-            prior.nearest(&unit(5), &options, &mut rng).unwrap()[0][0],
+            prior.nearest(&unit(5), 3, &options, &mut rng).unwrap()[0][0],
             300
         );
-        assert!(prior.nearest(&unit(9), &options, &mut rng).is_none());
+        assert!(prior.nearest(&unit(9), 3, &options, &mut rng).is_none());
         assert!(prior
-            .nearest(&[0.0; TEXT_DIM], &options, &mut rng)
+            .nearest(&[0.0; TEXT_DIM], 3, &options, &mut rng)
             .is_none());
     }
 }

@@ -31,6 +31,10 @@ struct ActionArgs {
     /// Sample each code only among the K most likely (default: all).
     #[arg(long)]
     top_k: Option<usize>,
+    /// Share of the retrieved training motion's tokens a motion keeps (0: text alone);
+    /// without it, the model's own setting.
+    #[arg(long)]
+    prior_keep: Option<f32>,
     /// Softmax temperature of the sampling (0 takes the most likely code).
     #[arg(long, default_value_t = coma::model::generate::SamplingOptions::default().temperature)]
     temperature: f32,
@@ -179,6 +183,12 @@ fn action_probe(generator: &MotionModel, probe: &ActionProbe, args: ActionArgs) 
     let options = coma::model::generate::SamplingOptions {
         top_k: args.top_k,
         temperature: args.temperature,
+        prior: args
+            .prior_keep
+            .map(|keep| coma::model::prior::PriorOptions {
+                keep,
+                ..Default::default()
+            }),
         ..Default::default()
     };
     let sampling = match args.top_k {
