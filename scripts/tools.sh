@@ -39,7 +39,7 @@ build_page() {
   # nginx's brotli_static and gzip_static): brotli for browsers that take it (the wasm at about
   # a tenth of its size, in half a minute), gzip for the rest (a sixth); the weights at about 0.9.
   find dist -type f \( -name '*.wasm' -o -name '*.js' -o -name '*.html' -o -name '*.json' \
-    -o -name '*.bpk' -o -name '*.i8' -o -name '*.txt' -o -name '*.npy' \) \
+    -o -name '*.bpk' -o -name '*.i8' -o -name '*.txt' -o -name '*.npy' -o -name '*.bin' \) \
     -exec gzip -9 -k -f {} +
   cargo run --release -q -p coma-serve -- --compress dist
 }

@@ -165,7 +165,7 @@ fn fresh_copy(path: &Path, suffix: &str) -> Option<PathBuf> {
 /// Endings of the page's files worth a compressed copy (images and the like are compressed
 /// already).
 pub const COMPRESSED: &[&str] = &[
-    ".wasm", ".js", ".html", ".json", ".bpk", ".i8", ".txt", ".npy",
+    ".wasm", ".js", ".html", ".json", ".bpk", ".i8", ".txt", ".npy", ".bin",
 ];
 
 /// Brotli quality of a file's copy: 10 for the wasm (about a tenth of its size; 11 saves a

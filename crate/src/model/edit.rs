@@ -10,6 +10,7 @@
 //!   of the next.
 
 use super::generate::{KeepResidual, MotionTokens, SamplingOptions};
+use super::prior::PriorMotion;
 use super::transformer::{PARTS, TEXT_DIM};
 use super::Spam;
 use crate::features::{FeatureFrame, FEATURE_DIM};
@@ -124,19 +125,20 @@ impl Spam {
         let mut rng = Rng::new(options.seed ^ 0x5052_494f_5221);
         // Parts that share a text share one training motion, and every part keeps the same
         // steps: whole-body key poses of one motion, which a mix of motions would not be.
-        let mut chosen: Vec<(&[f32; TEXT_DIM], Option<&[Vec<u32>; PARTS]>)> = Vec::new();
-        for t in text {
-            if !chosen.iter().any(|(c, _)| *c == t) {
-                chosen.push((t, prior.motions.nearest(t, n, &settings, &mut rng)));
-            }
+        let mut chosen: Vec<Option<&PriorMotion>> = Vec::with_capacity(PARTS);
+        for (p, t) in text.iter().enumerate() {
+            let motion = match text[..p].iter().position(|u| u == t) {
+                Some(q) => chosen[q],
+                None => prior.motions.nearest(t, n, &settings, &mut rng),
+            };
+            chosen.push(motion);
         }
         let kept: Vec<bool> = (0..n).map(|_| rng.uniform() < settings.keep).collect();
-        let found = chosen.iter().any(|(_, m)| m.is_some());
-        let fixed = text
+        let found = chosen.iter().any(Option::is_some);
+        let fixed = chosen
             .iter()
             .enumerate()
-            .map(|(p, t)| {
-                let motion = chosen.iter().find(|(c, _)| *c == t).and_then(|(_, m)| *m);
+            .map(|(p, motion)| {
                 (0..n)
                     .map(|s| {
                         // Stretched to the asked length (within about a quarter of it).

@@ -48,8 +48,11 @@ struct Key {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MotionPrior {
     keys: Vec<Key>,
-    motions: Vec<[Vec<u32>; PARTS]>,
+    motions: Vec<PriorMotion>,
 }
+
+/// One stored training motion's layer-0 codes, `[part][step]`.
+pub type PriorMotion = [Vec<u32>; PARTS];
 
 /// How generation uses the prior.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -288,7 +291,7 @@ impl MotionPrior {
         steps: usize,
         options: &PriorOptions,
         rng: &mut Rng,
-    ) -> Option<&[Vec<u32>; PARTS]> {
+    ) -> Option<&PriorMotion> {
         let query_norm = text.iter().map(|x| x * x).sum::<f32>().sqrt();
         if query_norm == 0.0 {
             return None;
