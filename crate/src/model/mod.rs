@@ -221,25 +221,14 @@ impl Spam {
         let options = serde_json::from_str::<SpamConfig>(files.config)
             .map_err(|e| file_error("spam.json", e.to_string()))?
             .prior;
-        spam.prior = match (options, files.prior) {
+        let prior = declared_file(PRIOR_FILE, "prior", options.is_some(), files.prior)?;
+        spam.prior = match (options, prior) {
             (Some(options), Some(bytes)) => Some(Prior {
                 motions: MotionPrior::from_bytes(bytes, spam.base_config.codebook_size)
                     .map_err(|e| file_error(PRIOR_FILE, e.to_string()))?,
                 options,
             }),
-            (Some(_), None) => {
-                return Err(file_error(
-                    PRIOR_FILE,
-                    "missing, but spam.json has prior options".into(),
-                ))
-            }
-            (None, Some(_)) => {
-                return Err(file_error(
-                    PRIOR_FILE,
-                    "present, but spam.json has no prior options (\"prior\": null)".into(),
-                ))
-            }
-            (None, None) => None,
+            _ => None,
         };
         Ok((spam, normalizer))
     }
@@ -258,25 +247,13 @@ impl Spam {
         let mut spam = Spam::random(&config.vq, &config.base, config.residual.as_ref(), device);
         spam.base =
             crate::weights::load_into(spam.base, base).map_err(|e| file_error("base.bpk", e))?;
-        match (spam.residual.as_mut(), residual) {
-            (Some(residual), Some(bytes)) => {
-                residual.network = crate::weights::load_into(residual.network.clone(), bytes)
-                    .map_err(|e| file_error(RESIDUAL_FILE, e))?;
-            }
-            (Some(_), None) => {
-                return Err(file_error(
-                    RESIDUAL_FILE,
-                    "missing, but spam.json sizes a residual transformer".into(),
-                ))
-            }
-            (None, Some(_)) => {
-                return Err(file_error(
-                    RESIDUAL_FILE,
-                    "present, but spam.json has no residual transformer (\"residual\": null)"
-                        .into(),
-                ))
-            }
-            (None, None) => {}
+        let declared = spam.residual.is_some();
+        if let (Some(residual), Some(bytes)) = (
+            spam.residual.as_mut(),
+            declared_file(RESIDUAL_FILE, "residual", declared, residual)?,
+        ) {
+            residual.network = crate::weights::load_into(residual.network.clone(), bytes)
+                .map_err(|e| file_error(RESIDUAL_FILE, e))?;
         }
         Ok(spam)
     }
@@ -325,9 +302,76 @@ impl Spam {
     }
 }
 
+/// An optional file of a model folder against `spam.json`'s `key`: its bytes when both have
+/// it, `None` when neither does, and an error naming the file when only one does.
+fn declared_file<'a>(
+    file: &str,
+    key: &str,
+    declared: bool,
+    bytes: Option<&'a [u8]>,
+) -> Result<Option<&'a [u8]>, SpamLoadError> {
+    match (declared, bytes) {
+        (true, None) => Err(file_error(
+            file,
+            format!("missing, but spam.json has \"{key}\""),
+        )),
+        (false, Some(_)) => Err(file_error(
+            file,
+            format!("present, but spam.json has no \"{key}\" (\"{key}\": null)"),
+        )),
+        (_, bytes) => Ok(bytes),
+    }
+}
+
 fn file_error(file: &str, message: String) -> SpamLoadError {
     SpamLoadError::File {
         file: file.to_string(),
         message,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_prior_loads_only_as_spam_json_declares_it() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../static/models");
+        let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
+        let config = String::from_utf8(read("spam.json")).unwrap();
+        let (vq, base, mean, std, prior) = (
+            read("vq.bpk"),
+            read("base.bpk"),
+            read("mean.npy"),
+            read("std.npy"),
+            read(PRIOR_FILE),
+        );
+        let mut sizes: SpamConfig = serde_json::from_str(&config).unwrap();
+        assert!(sizes.prior.is_some(), "the default model has a prior");
+        sizes.prior = None;
+        let undeclared = serde_json::to_string(&sizes).unwrap();
+        let device = Device::flex();
+        let load = |config: &str, prior: Option<&[u8]>| {
+            let files = SpamFiles {
+                config,
+                vq: &vq,
+                base: &base,
+                residual: None,
+                mean: &mean,
+                std: &std,
+                prior,
+            };
+            Spam::from_bytes(&files, &device).map(|(spam, _)| spam.prior.is_some())
+        };
+        assert!(load(&config, Some(&prior)).unwrap());
+        assert!(!load(&undeclared, None).unwrap());
+        let message = |r: Result<bool, SpamLoadError>| r.unwrap_err().to_string();
+        assert_eq!(
+            message(load(&config, None)),
+            "prior.bin: missing, but spam.json has \"prior\""
+        );
+        assert!(message(load(&undeclared, Some(&prior))).starts_with("prior.bin: present"));
+        let cut = message(load(&config, Some(&prior[..prior.len() / 2])));
+        assert!(cut.starts_with("prior.bin: "), "{cut}");
     }
 }
