@@ -339,9 +339,10 @@ pub struct ExportedPrior {
 
 /// `coma export prior`: the retrieval prior (see [`crate::model::prior`]) of the training
 /// motions of `data` (at most `per_action` of each action), tokenized by the VQ-VAE run `vq`
-/// (the f32 weights the transformers learnt from), with their captions embedded by the sentence encoder in `out`, written to
-/// `out/prior.bin`; `out/spam.json` gets `options` as the model's default. The folder must
-/// hold the model made from that VQ-VAE (`coma export spam` first), and is loaded back.
+/// (the f32 weights the transformers learnt from), with their captions embedded by the
+/// sentence encoder in `out`, written to `out/prior.bin`; `out/spam.json` gets `options` as
+/// the model's default. The folder must hold the model made from that VQ-VAE (`coma export
+/// spam` first), and is loaded back.
 pub fn export_prior(
     vq: &Path,
     data: &Path,
