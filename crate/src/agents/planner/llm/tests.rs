@@ -100,10 +100,11 @@ fn a_well_behaved_llm_plans_every_step() {
         assert_eq!(r.header("authorization"), Some("Bearer sk-test-secret"));
         assert!(!body.to_string().contains("sk-test-secret"));
     }
+    // The rewrite question tells the model's actions, a left/right pair as one.
     assert!(requests[0]
         .json()
         .to_string()
-        .contains("raise-up-left-hand"));
+        .contains("raise-up-{left|right}-hand"));
 }
 
 #[test]
