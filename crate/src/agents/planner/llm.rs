@@ -475,10 +475,11 @@ fn trajectory_from_reply(value: Value) -> Result<Trajectory, String> {
 }
 
 /// Characters the vocabulary brief may take. Small local models have 2,048-token contexts
-/// (CI's SmolLM2-135M among them) and English runs about 4 characters a token; the decompose
-/// question's own instructions and posture vocabulary take about 3,900 characters, so this
-/// leaves room for the segment and the reply.
-pub const BRIEF_CHARS: usize = 2_400;
+/// (CI's SmolLM2-135M among them): with a 2,400-character brief its server counted 2,113
+/// tokens in the decompose question alone (the posture vocabulary's JSON-like lines take
+/// more tokens per character than prose), so the brief keeps the actions and styles and
+/// leaves the example captions and the word list to models with room for them.
+pub const BRIEF_CHARS: usize = 1_000;
 
 /// What the motion model knows, for the rewrite and decompose questions, in at most `budget`
 /// characters: its actions (a left/right pair as one, `kick-{left|right}-leg`) and styles

@@ -256,8 +256,6 @@ fn the_questions_fit_a_small_model_s_context_with_the_shipped_vocabulary() {
         brief.contains("squat") && brief.contains("lie-down"),
         "{brief}"
     );
-    assert!(brief.contains("Example captions: \""), "{brief}");
-    // 2,048 tokens at about 4 characters each, less room for the segment and the reply.
     let longest = |messages: Vec<Message>| {
         messages
             .iter()
@@ -275,7 +273,8 @@ fn the_questions_fit_a_small_model_s_context_with_the_shipped_vocabulary() {
         ("decompose", longest(decompose_messages(&brief, segment))),
     ] {
         assert!(
-            chars <= 6_600,
+            // A decompose question 1,400 characters longer counted 2,113 tokens.
+            chars <= 5_200,
             "the {question} question takes {chars} characters"
         );
     }
