@@ -368,23 +368,16 @@ pub fn export_prior(
     );
     let text = SentenceEncoder::from_dir(out, &device)?;
     let train = MotionSet::load(data, Split::Train)?;
-    let tokens = crate::train::tokens::TokenSet::build(
-        &train,
-        &network,
-        &device,
-        &|t| Ok(text.encode(t)),
-        progress,
-    )?;
-    let kept = kept_per_action(&tokens, per_action);
+    // Only the kept motions are tokenized, and only their captions embedded (once each).
+    let kept = kept_per_action(&train, per_action);
+    progress(&format!("tokenizing {} training motions", kept.len()));
     // One key per caption with its subject said plainly: the subject words say nothing about
     // the motion, and each key is most of the file.
     let mut described: std::collections::BTreeMap<String, Vec<u32>> = Default::default();
-    for (m, item) in kept.iter().map(|i| &tokens.items[*i]).enumerate() {
+    for (m, item) in kept.iter().map(|i| &train.items[*i]).enumerate() {
         for c in &item.captions {
             let motions = described
-                .entry(crate::dataset::captions::with_plain_subject(
-                    &tokens.texts[*c],
-                ))
+                .entry(crate::dataset::captions::with_plain_subject(c))
                 .or_default();
             if motions.last() != Some(&(m as u32)) {
                 motions.push(m as u32);
@@ -402,7 +395,10 @@ pub fn export_prior(
         .collect();
     let motions = kept
         .iter()
-        .map(|i| std::array::from_fn(|p| tokens.items[*i].tokens[p][0].clone()))
+        .map(|i| {
+            let tokens = network.tokenize_motion(&train.items[*i].features, &device);
+            std::array::from_fn(|p| tokens[p][0].clone())
+        })
         .collect();
     let prior = MotionPrior::new(&captions, motions);
     let bytes = prior.to_bytes();
@@ -424,9 +420,9 @@ pub fn export_prior(
 /// Indices of at most `per_action` items of each action (unlabelled items counted as one
 /// action), drawn with a fixed seed, in their original order: every action stays, and the
 /// hundreds of walks and raised hands do not fill the page's download.
-fn kept_per_action(tokens: &crate::train::tokens::TokenSet, per_action: usize) -> Vec<usize> {
+fn kept_per_action(set: &MotionSet, per_action: usize) -> Vec<usize> {
     let mut by_action: std::collections::BTreeMap<Option<&str>, Vec<usize>> = Default::default();
-    for (i, item) in tokens.items.iter().enumerate() {
+    for (i, item) in set.items.iter().enumerate() {
         by_action
             .entry(item.content.as_deref())
             .or_default()
