@@ -53,6 +53,8 @@ pub mod share;
 pub mod skeleton;
 pub mod text;
 pub mod timing;
+// Training loops need burn's autodiff and optimizers, which the page leaves out.
+#[cfg(feature = "train")]
 pub mod train;
 pub mod trajectory;
 pub mod weights;

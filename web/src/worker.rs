@@ -12,10 +12,13 @@ use coma::agents::llm::LlmClient;
 use coma::model::evaluator::Evaluator;
 use coma::model::guidance::GuidancePartner;
 use coma::model::motion_model::TextFiles;
-use coma::model::{MotionModel, SpamConfig, SpamFiles, PRIOR_FILE, RESIDUAL_FILE};
+use coma::model::{
+    model_id_from_digest, MotionModel, SpamConfig, SpamFiles, PRIOR_FILE, RESIDUAL_FILE,
+};
 use coma::session::{Command, Session, VOCABULARY_FILE};
 use coma::text::minilm::{MODEL_FILE, VOCAB_FILE, WORDS_FILE};
-use std::cell::RefCell;
+use futures::future::join_all;
+use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
@@ -178,29 +181,40 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
         .chain(TEXT_FILES)
         .collect();
     let total = (names.len() + 1 + EVALUATOR_FILES.len() + 1) as u64;
-    let mut done = 1u64;
-    let mut bytes = config_bytes.len() as u64;
-    let mut download = async |name: &str| {
+    let done = Cell::new(1u64);
+    let bytes = Cell::new(config_bytes.len() as u64);
+    // Every file is asked for at once, and the device chosen meanwhile: a repeat visit's
+    // files come from the browser's cache after one revalidation each, so waiting for them one
+    // by one and then for the WebGPU adapter would be most of its start.
+    let download = async |name: &str| {
+        let data = fetch(&format!("{base}/{name}")).await?;
+        done.set(done.get() + 1);
+        bytes.set(bytes.get() + data.len() as u64);
         post(&Reply::Loading {
-            stage: format!("downloading the model: {name}"),
-            done,
+            stage: format!("downloading the model: {name} arrived"),
+            done: done.get(),
             total,
         });
-        done += 1;
-        let data = fetch(&format!("{base}/{name}")).await?;
-        bytes += data.len() as u64;
         Ok::<_, String>(data)
     };
+    // The evaluator and the vocabulary are optional: a failure there costs the review or the
+    // LLM planner, not the page.
+    let (model_files, (evaluator_config, evaluator_weights, vocabulary_file), chosen) = futures::join!(
+        join_all(names.iter().map(|&name| download(name))),
+        async {
+            futures::join!(
+                download(EVALUATOR_FILES[0]),
+                download(EVALUATOR_FILES[1]),
+                download(VOCABULARY_FILE)
+            )
+        },
+        choose_device(asked),
+    );
+    let (device, backend, mut note) = chosen;
     let mut files = std::collections::HashMap::new();
-    for name in names {
-        files.insert(name, download(name).await?);
+    for (name, data) in names.into_iter().zip(model_files) {
+        files.insert(name, data?);
     }
-    // Optional: a failure here costs the review or the LLM planner, not the page.
-    let evaluator_files = [
-        download(EVALUATOR_FILES[0]).await,
-        download(EVALUATOR_FILES[1]).await,
-    ];
-    let vocabulary_file = download(VOCABULARY_FILE).await;
     post(&Reply::Loading {
         stage: "preparing the model".into(),
         done: total,
@@ -212,7 +226,6 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
     };
     let config = std::str::from_utf8(&config_bytes)
         .map_err(|_| "spam.json is not UTF-8 text".to_string())?;
-    let (device, backend, mut note) = choose_device(asked).await;
     // On the CPU a second worker runs guidance's unconditional passes (see partner.rs); it
     // loads its copy of the transformers while this one loads the rest.
     let partner = match backend {
@@ -236,28 +249,31 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
     // The sentence encoder and the evaluator stay on the CPU: they answer synchronous calls
     // of the planner and the reviewer, and are quick there.
     let cpu = burn::tensor::Device::flex();
-    let mut model = MotionModel::from_files(
-        &SpamFiles {
-            config,
-            vq: file("vq.bpk"),
-            base: file("base.bpk"),
-            residual: files.get(RESIDUAL_FILE).map(Vec::as_slice),
-            mean: file("mean.npy"),
-            std: file("std.npy"),
-            prior: files.get(PRIOR_FILE).map(Vec::as_slice),
-        },
+    let spam_files = SpamFiles {
+        config,
+        vq: file("vq.bpk"),
+        base: file("base.bpk"),
+        residual: files.get(RESIDUAL_FILE).map(Vec::as_slice),
+        mean: file("mean.npy"),
+        std: file("std.npy"),
+        prior: files.get(PRIOR_FILE).map(Vec::as_slice),
+    };
+    let mut model = MotionModel::from_files_hashed(
+        &spam_files,
         &TextFiles {
             vocab: text(VOCAB_FILE)?,
             words: file(WORDS_FILE),
             model: file(MODEL_FILE),
         },
+        model_id(&spam_files),
         &device,
         &cpu,
     )
+    .await
     .map_err(|e| format!("the model does not load: {e}"))?;
     let workers = 1 + partner.is_some() as u32;
     model.spam.partner = partner.map(|p| p as Rc<dyn GuidancePartner>);
-    let evaluator = match evaluator_files {
+    let evaluator = match [evaluator_config, evaluator_weights] {
         [Ok(config), Ok(weights)] => std::str::from_utf8(&config)
             .map_err(|_| "evaluator.json is not UTF-8 text".to_string())
             .and_then(|config| {
@@ -280,11 +296,35 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
         backend,
         note,
         workers,
-        bytes,
+        bytes: bytes.get(),
         millis: now() - started,
         missing,
         training_data,
     })
+}
+
+/// The model id of `files` (see [`coma::model::model_id`]), hashed by the browser's SHA-256
+/// (WebCrypto, on its own threads, many times faster than one compiled to wasm), which starts
+/// at once; the wasm's own where the browser offers none (a page not from a secure origin).
+fn model_id<'a>(files: &'a SpamFiles<'a>) -> impl std::future::Future<Output = String> + 'a {
+    let digest = js_sys::Reflect::get(&scope(), &"crypto".into())
+        .ok()
+        .and_then(|crypto| crypto.dyn_into::<web_sys::Crypto>().ok())
+        .and_then(|crypto| {
+            crypto
+                .subtle()
+                .digest_with_str_and_u8_array("SHA-256", &files.id_message())
+                .ok()
+        })
+        .map(wasm_bindgen_futures::JsFuture::from);
+    async move {
+        if let Some(digest) = digest {
+            if let Ok(buffer) = digest.await {
+                return model_id_from_digest(&js_sys::Uint8Array::new(&buffer).to_vec());
+            }
+        }
+        files.id()
+    }
 }
 
 /// Logical cores the browser reports (`navigator.hardwareConcurrency`; 1 if it does not say).

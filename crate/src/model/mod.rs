@@ -143,18 +143,28 @@ pub const RESIDUAL_FILE: &str = "residual.bpk";
 pub const PRIOR_FILE: &str = "prior.bin";
 
 /// A model's id: the first 16 hex digits of the SHA-256 of its weight files, in
-/// [`SpamConfig::weight_files`] order. Share links name the model they were made with by this id.
+/// [`SpamConfig::weight_files`] order (see [`model_id_message`]). Share links name the model
+/// they were made with by this id.
 pub fn model_id(files: &[&[u8]]) -> String {
     use sha2::{Digest, Sha256};
-    let mut hash = Sha256::new();
+    model_id_from_digest(&Sha256::digest(model_id_message(files)))
+}
+
+/// What a model id hashes: each file's length in bytes (u64, little-endian), then its bytes.
+/// The page hands it to the browser's own SHA-256, which is many times faster than one
+/// compiled to wasm.
+pub fn model_id_message(files: &[&[u8]]) -> Vec<u8> {
+    let mut message = Vec::with_capacity(files.iter().map(|f| f.len() + 8).sum());
     for f in files {
-        hash.update((f.len() as u64).to_le_bytes());
-        hash.update(f);
+        message.extend_from_slice(&(f.len() as u64).to_le_bytes());
+        message.extend_from_slice(f);
     }
-    hash.finalize()[..8]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
+    message
+}
+
+/// A model id from the SHA-256 digest of its [`model_id_message`].
+pub fn model_id_from_digest(digest: &[u8]) -> String {
+    digest.iter().take(8).map(|b| format!("{b:02x}")).collect()
 }
 
 /// The id of the model in a folder (see [`model_id`]).
@@ -197,11 +207,20 @@ pub struct SpamFiles<'a> {
 impl SpamFiles<'_> {
     /// The model id of these files (see [`model_id`]).
     pub fn id(&self) -> String {
+        model_id(&self.in_id_order())
+    }
+
+    /// What their model id hashes (see [`model_id_message`]).
+    pub fn id_message(&self) -> Vec<u8> {
+        model_id_message(&self.in_id_order())
+    }
+
+    fn in_id_order(&self) -> Vec<&[u8]> {
         let mut files: Vec<&[u8]> = vec![self.config.as_bytes(), self.vq, self.base];
         files.extend(self.residual);
         files.extend([self.mean, self.std]);
         files.extend(self.prior);
-        model_id(&files)
+        files
     }
 }
 
@@ -333,6 +352,16 @@ fn file_error(file: &str, message: String) -> SpamLoadError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_model_id_is_the_sha256_of_length_prefixed_files() {
+        let files: [&[u8]; 3] = [b"{\"a\":1}", b"", &[0, 1, 2, 3, 4, 5, 6]];
+        let message = model_id_message(&files);
+        assert_eq!(message.len(), 3 * 8 + 7 + 7);
+        assert_eq!(&message[..8], &7u64.to_le_bytes());
+        // From Python's hashlib over the same bytes: what the browser's SHA-256 also gives.
+        assert_eq!(model_id(&files), "240d50a1f6c97ea2");
+    }
 
     #[test]
     fn a_prior_loads_only_as_spam_json_declares_it() {

@@ -50,15 +50,44 @@ impl MotionModel {
         device: &Device,
         text_device: &Device,
     ) -> Result<MotionModel, MotionModelError> {
-        let id = spam.id();
-        let (spam, normalizer) = Spam::from_bytes(spam, device)?;
-        let text = SentenceEncoder::from_bytes(text.vocab, text.words, text.model, text_device)?;
+        let ((spam_model, normalizer), text) =
+            Self::parts_from_files(spam, text, device, text_device)?;
+        Ok(MotionModel {
+            spam: spam_model,
+            normalizer,
+            text,
+            id: spam.id(),
+        })
+    }
+
+    /// The same, with the model id from `id`, awaited once the weights are loaded: the page
+    /// has the browser hash [`SpamFiles::id_message`] on its own threads meanwhile.
+    pub async fn from_files_hashed(
+        spam: &SpamFiles<'_>,
+        text: &TextFiles<'_>,
+        id: impl std::future::Future<Output = String>,
+        device: &Device,
+        text_device: &Device,
+    ) -> Result<MotionModel, MotionModelError> {
+        let ((spam, normalizer), text) = Self::parts_from_files(spam, text, device, text_device)?;
         Ok(MotionModel {
             spam,
             normalizer,
             text,
-            id,
+            id: id.await,
         })
+    }
+
+    fn parts_from_files(
+        spam: &SpamFiles,
+        text: &TextFiles,
+        device: &Device,
+        text_device: &Device,
+    ) -> Result<((Spam, Normalizer), SentenceEncoder), MotionModelError> {
+        Ok((
+            Spam::from_bytes(spam, device)?,
+            SentenceEncoder::from_bytes(text.vocab, text.words, text.model, text_device)?,
+        ))
     }
 
     /// The model in a folder (the default one is `static/models`).

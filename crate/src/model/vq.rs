@@ -500,6 +500,7 @@ impl MotionVq {
     /// encoder and the codebooks held as they are: gradients reach the decoder alone. It
     /// fine-tunes a decoder for motions generated with fewer layers than the VQ-VAE has (a
     /// base-only model decodes layer 0 alone), without changing any token.
+    #[cfg(feature = "train")]
     pub fn forward_decoder_train(&self, x: Tensor<3>, layers: usize) -> Tensor<3> {
         // The encoder and the codebooks run without autodiff: a graph that no loss flows back
         // through is never freed, and it filled 24 GiB in a few hundred steps.

@@ -109,11 +109,14 @@ pub struct EvaluatorTrainOptions {
 }
 
 fn learning_rate(config: &EvaluatorTrainingConfig, step: usize) -> f64 {
-    let warm = ((step + 1) as f64 / config.warmup_steps.max(1) as f64).min(1.0);
-    // Cosine decay to a tenth after the warm-up.
-    let progress = step as f64 / config.steps.max(1) as f64;
-    let decay = 0.1 + 0.9 * 0.5 * (1.0 + (std::f64::consts::PI * progress).cos());
-    config.learning_rate * warm * decay
+    // Cosine decay to a tenth.
+    super::warmup_cosine(
+        config.learning_rate,
+        config.warmup_steps,
+        config.steps,
+        0.1,
+        step,
+    )
 }
 
 /// Top-3 R-precision (batches of 32) of the evaluator on motions and their first caption,

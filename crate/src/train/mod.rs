@@ -24,6 +24,16 @@ pub fn training_device(name: &str) -> anyhow::Result<burn::tensor::Device> {
     }
 }
 
+/// Learning rate of optimizer step `step` (from 0) of `steps`: a linear warm-up over
+/// `warmup_steps`, times a cosine that falls from 1 at the first step to `floor` at the last
+/// (`floor` 1 keeps the rate constant after the warm-up).
+pub fn warmup_cosine(base: f64, warmup_steps: usize, steps: usize, floor: f64, step: usize) -> f64 {
+    let warm = ((step + 1) as f64 / warmup_steps.max(1) as f64).min(1.0);
+    let progress = (step as f64 / steps.max(1) as f64).min(1.0);
+    let cosine = 0.5 * (1.0 + (std::f64::consts::PI * progress).cos());
+    base * warm * (floor + (1.0 - floor) * cosine)
+}
+
 /// Action shares as a log line, largest first: `walk 41.2 %, run 9.0 %, …`.
 pub fn format_shares(shares: &std::collections::BTreeMap<String, f64>) -> String {
     let mut sorted: Vec<(&String, &f64)> = shares.iter().collect();
@@ -79,3 +89,31 @@ read_as_written!(
     transformer::TransformerTrainingConfig,
     evaluator::EvaluatorTrainingConfig
 );
+
+#[cfg(test)]
+mod tests {
+    use super::warmup_cosine;
+
+    #[test]
+    fn learning_rate_warms_up_then_falls_to_its_floor() {
+        let rate = |step| warmup_cosine(2e-4, 10, 110, 0.1, step);
+        assert!((rate(0) - 2e-5).abs() < 1e-12, "a tenth of the warm-up");
+        assert!(
+            (rate(9)
+                - 2e-4 * (0.1 + 0.9 * 0.5 * (1.0 + (9.0f64 / 110.0 * std::f64::consts::PI).cos())))
+            .abs()
+                < 1e-12
+        );
+        assert!(
+            (rate(55) - 2e-4 * 0.55).abs() < 1e-12,
+            "halfway down the cosine"
+        );
+        assert!((rate(110) - 2e-5).abs() < 1e-12, "the floor at the end");
+        assert!(
+            (1..110).all(|s| s < 10 || rate(s) < rate(s - 1)),
+            "falls after the warm-up"
+        );
+        // A floor of 1 is the constant rate the first runs trained with.
+        assert!((20..100).all(|s| (warmup_cosine(3e-4, 10, 100, 1.0, s) - 3e-4).abs() < 1e-15));
+    }
+}

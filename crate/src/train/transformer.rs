@@ -34,6 +34,10 @@ pub struct TransformerTrainingConfig {
     pub learning_rate: f64,
     #[config(default = 1000)]
     pub warmup_steps: usize,
+    /// Share of the learning rate left at the last step, reached along a cosine (1 keeps it
+    /// constant after the warm-up, as the first runs trained).
+    #[config(default = 1.0)]
+    pub final_rate: f64,
     /// Probability that a part is conditioned on its own sentence rather than the caption.
     #[config(default = 0.3)]
     pub part_text: f64,
@@ -274,7 +278,13 @@ pub fn train_transformer(
         };
         let (loss, accuracy) = loss_and_accuracy(logits, &inputs, config.label_smoothing);
         let loss_value = loss.clone().into_scalar::<f32>() as f64;
-        let lr = config.learning_rate * ((step + 1) as f64 / config.warmup_steps as f64).min(1.0);
+        let lr = super::warmup_cosine(
+            config.learning_rate,
+            config.warmup_steps,
+            config.steps,
+            config.final_rate,
+            step,
+        );
         let grads = GradientsParams::from_grads(loss.backward(), &model);
         model = optim.step(lr, model, grads);
         run.record(config.batch_size, &[loss_value, accuracy])?;
