@@ -191,7 +191,7 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
         done.set(done.get() + 1);
         bytes.set(bytes.get() + data.len() as u64);
         post(&Reply::Loading {
-            stage: format!("downloading the model: {name} arrived"),
+            stage: format!("downloading the model: {name} received"),
             done: done.get(),
             total,
         });
