@@ -199,15 +199,11 @@ async fn load(base: &str, asked: Option<Backend>) -> Result<Reply, String> {
     };
     // The evaluator and the vocabulary are optional: a failure there costs the review or the
     // LLM planner, not the page.
-    let (model_files, (evaluator_config, evaluator_weights, vocabulary_file), chosen) = futures::join!(
+    let (model_files, evaluator_config, evaluator_weights, vocabulary_file, chosen) = futures::join!(
         join_all(names.iter().map(|&name| download(name))),
-        async {
-            futures::join!(
-                download(EVALUATOR_FILES[0]),
-                download(EVALUATOR_FILES[1]),
-                download(VOCABULARY_FILE)
-            )
-        },
+        download(EVALUATOR_FILES[0]),
+        download(EVALUATOR_FILES[1]),
+        download(VOCABULARY_FILE),
         choose_device(asked),
     );
     let (device, backend, mut note) = chosen;
