@@ -27,14 +27,15 @@
 //! same engine.
 
 pub mod agents;
-#[cfg(not(target_arch = "wasm32"))]
+// Times training steps too, and the CLI is its only caller: native only.
+#[cfg(feature = "native")]
 pub mod bench;
 pub mod bvh;
 pub mod dataset;
 pub mod eval;
 pub mod executor;
 // Assembles trained runs into a model folder: native only (files, training configs).
-#[cfg(not(target_arch = "wasm32"))]
+#[cfg(feature = "native")]
 pub mod export;
 pub mod features;
 pub mod geom;
