@@ -8,6 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/tools.sh
 ensure_rust_tools
+ensure_wasm_test_runner
 if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
   ensure_browser_tools
 fi

@@ -5,6 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/tools.sh
 ensure_rust_tools
+ensure_wasm_test_runner
 
 echo "== format and lints"
 cargo fmt --all -- --check

@@ -1,12 +1,18 @@
 # Shared by start.sh and test.sh: installs the tools the build needs, only when missing or at
 # the wrong version, so a machine that already has them starts at once.
+# The wasm-bindgen of Cargo.lock (and of serve/src/bind.rs; a test checks that all three agree).
 WASM_BINDGEN_VERSION=0.2.130
 
 ensure_rust_tools() {
   rustup component list --installed 2>/dev/null | grep -q '^clippy' || rustup component add clippy
   rustup component list --installed 2>/dev/null | grep -q '^rustfmt' || rustup component add rustfmt
   rustup target list --installed | grep -qx wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
-  if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $WASM_BINDGEN_VERSION" ]; then
+}
+
+# The wasm tests' runner (wasm-bindgen-test-runner). Only the tests need it: the page's build
+# writes its JavaScript glue with `coma-serve --bind` (the same library, about 40 % of the CPU time to build).
+ensure_wasm_test_runner() {
+  if [ "$(wasm-bindgen-test-runner --version 2>/dev/null)" != "wasm-bindgen-test-runner $WASM_BINDGEN_VERSION" ]; then
     echo "installing wasm-bindgen-cli $WASM_BINDGEN_VERSION (a few minutes, once)"
     # Without --locked: its lock file names a crate version the registry no longer serves.
     cargo install wasm-bindgen-cli --version "$WASM_BINDGEN_VERSION" --no-default-features
@@ -30,9 +36,9 @@ build_page() {
   local target_dir="${CARGO_TARGET_DIR:-target}"
   cargo build --release -p coma-web --target wasm32-unknown-unknown
   rm -rf dist && mkdir -p dist/pkg
-  # Without the name section: function names for stack traces, megabytes users would download.
-  wasm-bindgen --target web --no-typescript --remove-name-section --out-dir dist/pkg \
-    "$target_dir/wasm32-unknown-unknown/release/coma_web.wasm"
+  # The JavaScript glue, as `wasm-bindgen --target web --no-typescript --remove-name-section`.
+  cargo run --release -q -p coma-serve -- --bind \
+    "$target_dir/wasm32-unknown-unknown/release/coma_web.wasm" dist/pkg
   cp index.html dist/
   cp -r static dist/static
   # Compressed copies beside the files for hosts that serve them (`coma serve` does, as do

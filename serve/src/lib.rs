@@ -7,6 +7,9 @@
 //! size (a sixth with gzip). Any static host can do the same (nginx: `brotli_static on`,
 //! `gzip_static on`).
 
+#[cfg(feature = "bind")]
+pub mod bind;
+
 use anyhow::{Context, Result};
 use std::io::{BufRead, BufReader, Write};
 use std::net::{TcpListener, TcpStream};
