@@ -85,14 +85,58 @@ macro_rules! read_as_written {
         }
     )*};
 }
-read_as_written!(
-    transformer::TransformerTrainingConfig,
-    evaluator::EvaluatorTrainingConfig
-);
+read_as_written!(evaluator::EvaluatorTrainingConfig);
 
 #[cfg(test)]
 mod tests {
-    use super::warmup_cosine;
+    use super::{warmup_cosine, ReadConfig};
+
+    /// Every training configuration in `configs/` and every run's `config.json` reads, as
+    /// the command that resumes or repeats it reads them: a field added to a configuration
+    /// must not stop older runs from resuming.
+    #[test]
+    fn every_committed_training_configuration_reads() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut paths: Vec<_> = std::fs::read_dir(root.join("configs"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        for run in std::fs::read_dir(root.join("runs")).unwrap() {
+            let config = run.unwrap().path().join("config.json");
+            if config.exists() {
+                paths.push(config);
+            }
+        }
+        let mut read = 0;
+        for path in &paths {
+            let text = path.to_string_lossy();
+            let result = if text.contains("vq") {
+                super::vq::VqTrainingConfig::read(path).map(|_| ())
+            } else if text.contains("evaluator") {
+                super::evaluator::EvaluatorTrainingConfig::read(path).map(|_| ())
+            } else if text.contains("base") || text.contains("res") {
+                super::transformer::TransformerTrainingConfig::read(path).map(|_| ())
+            } else {
+                // The network sizes (spam.json, paper.json), not a training configuration.
+                continue;
+            };
+            result.unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+            read += 1;
+        }
+        assert!(read >= 20, "only {read} configurations found");
+        let res2 = super::transformer::TransformerTrainingConfig::read(
+            &root.join("runs/res2/config.json"),
+        );
+        assert_eq!(
+            res2.unwrap().final_rate,
+            1.0,
+            "a run from before the anneal keeps a constant rate"
+        );
+        let anneal = super::transformer::TransformerTrainingConfig::read(
+            &root.join("configs/base-anneal.json"),
+        );
+        assert_eq!(anneal.unwrap().final_rate, 0.05);
+    }
 
     #[test]
     fn learning_rate_warms_up_then_falls_to_its_floor() {

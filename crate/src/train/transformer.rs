@@ -60,6 +60,19 @@ pub struct TransformerTrainingConfig {
     pub balance_from: usize,
 }
 
+impl super::ReadConfig for TransformerTrainingConfig {
+    /// Fields added since a run was written (`final_rate`) take their defaults, which keep
+    /// the run as it trained: a run resumes with the schedule it started with.
+    fn read(path: &std::path::Path) -> anyhow::Result<Self> {
+        use anyhow::Context;
+        super::read_with_defaults(path, |file| {
+            let model = serde_json::from_value(file.get("model").cloned().unwrap_or_default())
+                .with_context(|| format!("{} has no valid \"model\"", path.display()))?;
+            Ok(TransformerTrainingConfig::new(model))
+        })
+    }
+}
+
 /// Inputs and targets of one step.
 struct Step {
     inputs: Tensor<3, Int>,
