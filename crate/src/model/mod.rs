@@ -147,7 +147,13 @@ pub const PRIOR_FILE: &str = "prior.bin";
 /// they were made with by this id.
 pub fn model_id(files: &[&[u8]]) -> String {
     use sha2::{Digest, Sha256};
-    model_id_from_digest(&Sha256::digest(model_id_message(files)))
+    // Streamed into the hash: the joined message would copy every weight file once more.
+    let mut hash = Sha256::new();
+    for f in files {
+        hash.update((f.len() as u64).to_le_bytes());
+        hash.update(f);
+    }
+    model_id_from_digest(&hash.finalize())
 }
 
 /// What a model id hashes: each file's length in bytes (u64, little-endian), then its bytes.
@@ -361,6 +367,11 @@ mod tests {
         assert_eq!(&message[..8], &7u64.to_le_bytes());
         // From Python's hashlib over the same bytes: what the browser's SHA-256 also gives.
         assert_eq!(model_id(&files), "240d50a1f6c97ea2");
+        use sha2::{Digest, Sha256};
+        assert_eq!(
+            model_id_from_digest(&Sha256::digest(&message)),
+            "240d50a1f6c97ea2"
+        );
     }
 
     #[test]

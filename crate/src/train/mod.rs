@@ -97,24 +97,27 @@ mod tests {
     #[test]
     fn every_committed_training_configuration_reads() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let mut paths: Vec<_> = std::fs::read_dir(root.join("configs"))
+        // Each with the name that says which network it trains: the file's in `configs/`,
+        // the run folder's in `runs/`.
+        let mut paths: Vec<(String, std::path::PathBuf)> = std::fs::read_dir(root.join("configs"))
             .unwrap()
-            .map(|e| e.unwrap().path())
+            .map(|e| (e.as_ref().unwrap().file_name(), e.unwrap().path()))
+            .map(|(name, path)| (name.to_string_lossy().into_owned(), path))
             .collect();
         for run in std::fs::read_dir(root.join("runs")).unwrap() {
-            let config = run.unwrap().path().join("config.json");
+            let run = run.unwrap();
+            let config = run.path().join("config.json");
             if config.exists() {
-                paths.push(config);
+                paths.push((run.file_name().to_string_lossy().into_owned(), config));
             }
         }
         let mut read = 0;
-        for path in &paths {
-            let text = path.to_string_lossy();
-            let result = if text.contains("vq") {
+        for (name, path) in &paths {
+            let result = if name.starts_with("vq") {
                 super::vq::VqTrainingConfig::read(path).map(|_| ())
-            } else if text.contains("evaluator") {
+            } else if name.starts_with("evaluator") {
                 super::evaluator::EvaluatorTrainingConfig::read(path).map(|_| ())
-            } else if text.contains("base") || text.contains("res") {
+            } else if name.starts_with("base") || name.starts_with("res") {
                 super::transformer::TransformerTrainingConfig::read(path).map(|_| ())
             } else {
                 // The network sizes (spam.json, paper.json), not a training configuration.
