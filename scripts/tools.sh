@@ -10,7 +10,7 @@ ensure_rust_tools() {
 }
 
 # The wasm tests' runner (wasm-bindgen-test-runner). Only the tests need it: the page's build
-# writes its JavaScript glue with `coma-serve --bind` (the same library, about 40 % of the CPU time to build).
+# writes its JavaScript glue with `coma-serve --bind` (the same library, without the runner's server).
 ensure_wasm_test_runner() {
   if [ "$(wasm-bindgen-test-runner --version 2>/dev/null)" != "wasm-bindgen-test-runner $WASM_BINDGEN_VERSION" ]; then
     echo "installing wasm-bindgen-cli $WASM_BINDGEN_VERSION (a few minutes, once)"

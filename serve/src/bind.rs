@@ -1,7 +1,7 @@
 //! The page's JavaScript glue, written from the built wasm by wasm-bindgen's own library (the
 //! code its command line runs). Starting the page then needs no `wasm-bindgen` command: that
-//! crate, with its test runner's web server and HTTP client, takes over twice the CPU time to
-//! build as this library, and only the tests need its runner.
+//! crate also builds an argument parser and its test runner's web server and HTTP client, and
+//! only the tests need the runner.
 
 use anyhow::{Context, Result};
 use std::path::Path;
