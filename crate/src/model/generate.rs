@@ -17,8 +17,12 @@ pub struct SamplingOptions {
     pub base_guidance: f32,
     /// Guidance scale of the residual transformer.
     pub residual_guidance: f32,
-    /// Softmax temperature (0 takes the most likely code).
+    /// Softmax temperature of the base tokens (0 takes the most likely code).
     pub temperature: f32,
+    /// Softmax temperature of the residual layers' tokens (0 takes the most likely code).
+    /// They carry detail rather than the action, so sampling them only adds noise to what
+    /// the base tokens chose.
+    pub residual_temperature: f32,
     /// Sample only among the `k` most likely codes.
     pub top_k: Option<usize>,
     /// How a new motion uses the model's retrieval prior; `None` takes the model's own
@@ -37,6 +41,7 @@ impl Default for SamplingOptions {
             base_guidance: 6.0,
             residual_guidance: 5.0,
             temperature: 1.0,
+            residual_temperature: 0.0,
             top_k: None,
             prior: None,
             seed: 0,
@@ -77,8 +82,8 @@ fn probabilities(logits: &[f32], temperature: f32, top_k: Option<usize>) -> Vec<
 }
 
 /// Draws a code (most likely one at temperature 0) and returns it with its probability.
-fn sample(logits: &[f32], options: &SamplingOptions, rng: &mut Rng) -> (u32, f32) {
-    if options.temperature <= 0.0 {
+fn sample(logits: &[f32], temperature: f32, top_k: Option<usize>, rng: &mut Rng) -> (u32, f32) {
+    if temperature <= 0.0 {
         let (i, _) = logits
             .iter()
             .enumerate()
@@ -88,7 +93,7 @@ fn sample(logits: &[f32], options: &SamplingOptions, rng: &mut Rng) -> (u32, f32
             );
         return (i as u32, 1.0);
     }
-    let p = probabilities(logits, options.temperature, options.top_k);
+    let p = probabilities(logits, temperature, top_k);
     let u = rng.uniform();
     let mut acc = 0.0;
     for (i, pi) in p.iter().enumerate() {
@@ -148,7 +153,8 @@ impl Spam {
                 .guided_logits(&pass, &inputs, options.base_guidance)
                 .await;
             for i in remasked {
-                let (code, p) = sample(&logits[i * k..(i + 1) * k], options, rng);
+                let row = &logits[i * k..(i + 1) * k];
+                let (code, p) = sample(row, options.temperature, options.top_k, rng);
                 ids[i] = code;
                 confidence[i] = p;
             }
@@ -190,8 +196,8 @@ impl Spam {
             for (p, part) in layers.iter_mut().enumerate() {
                 let row: Vec<u32> = (0..n)
                     .map(|s| {
-                        let drawn =
-                            sample(&logits[(p * n + s) * k..(p * n + s + 1) * k], options, rng).0;
+                        let row = &logits[(p * n + s) * k..(p * n + s + 1) * k];
+                        let drawn = sample(row, options.residual_temperature, options.top_k, rng).0;
                         match &keep {
                             Some(keep) if !keep.editable[p][s] => keep.tokens[p][j][s],
                             _ => drawn,
@@ -233,13 +239,16 @@ pub(crate) mod tests {
             temperature: 0.0,
             ..Default::default()
         };
-        assert_eq!(sample(&logits, &greedy, &mut rng).0, 1);
+        assert_eq!(
+            sample(&logits, greedy.temperature, greedy.top_k, &mut rng).0,
+            1
+        );
         let top2 = SamplingOptions {
             top_k: Some(2),
             ..Default::default()
         };
         for _ in 0..200 {
-            let (c, _) = sample(&logits, &top2, &mut rng);
+            let (c, _) = sample(&logits, top2.temperature, top2.top_k, &mut rng);
             assert!(c == 1 || c == 3);
         }
     }
@@ -292,6 +301,27 @@ pub(crate) mod tests {
         assert!(
             a.iter().flatten().flatten().all(|t| *t < 16),
             "no mask or pad ids in the output"
+        );
+    }
+
+    #[test]
+    fn greedy_residual_layers_follow_the_base_tokens_not_the_seed() {
+        let spam = Spam::random(&tiny_vq(), &small(), Some(&small()), &Device::flex());
+        let text = [[0.1f32; TEXT_DIM]; PARTS];
+        let base: Vec<Vec<u32>> = (0..PARTS as u32).map(|p| vec![p, 3, 9, 1]).collect();
+        let residual = |residual_temperature: f32, seed: u64| {
+            let options = SamplingOptions {
+                residual_temperature,
+                ..Default::default()
+            };
+            let mut rng = Rng::new(seed);
+            block_on(spam.decode_residual(&text, base.clone(), None, &options, &mut rng))
+        };
+        assert_eq!(residual(0.0, 1), residual(0.0, 2));
+        assert_ne!(
+            residual(1.0, 1),
+            residual(1.0, 2),
+            "sampled layers vary by seed"
         );
     }
 

@@ -470,6 +470,28 @@ pub fn reconstruction_errors(
     Ok(reconstruction_errors_by(model, set, device, limit, layers, |_| None)?.0)
 }
 
+/// Share of the layer-0 codes that two VQ-VAEs give the same motions, over every part and
+/// step: how much of what a base transformer learned on `other`'s tokens still holds for
+/// `model`'s (1 when a fine-tune moved no code).
+pub fn base_code_agreement(
+    model: &MotionVq,
+    other: &MotionVq,
+    set: &MotionSet,
+    device: &Device,
+    limit: usize,
+) -> f64 {
+    let (mut same, mut all) = (0usize, 0usize);
+    for item in set.items.iter().take(limit) {
+        let a = model.tokenize_motion(&item.features, device);
+        let b = other.tokenize_motion(&item.features, device);
+        for (pa, pb) in a.iter().zip(&b) {
+            same += pa[0].iter().zip(&pb[0]).filter(|(x, y)| x == y).count();
+            all += pa[0].len();
+        }
+    }
+    same as f64 / all.max(1) as f64
+}
+
 /// How predictable one residual layer's codes are, over a set of motions: entropies in nats
 /// (ln 256 = 5.55 for codes used uniformly at random), from code counts per body part.
 #[derive(Clone, Debug)]
@@ -560,4 +582,42 @@ pub fn code_statistics(
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dataset::motions::MotionItem;
+
+    fn motions() -> MotionSet {
+        let mut rng = Rng::new(11);
+        let items = (0..3)
+            .map(|i| MotionItem {
+                name: format!("m{i}"),
+                features: (0..24)
+                    .map(|_| std::array::from_fn(|_| rng.uniform() * 2.0 - 1.0))
+                    .collect(),
+                captions: Vec::new(),
+                parts: Default::default(),
+                content: None,
+                source: None,
+            })
+            .collect();
+        let identity = Normalizer {
+            mean: vec![0.0; FEATURE_DIM],
+            std: vec![1.0; FEATURE_DIM],
+        };
+        MotionSet::new(items, identity)
+    }
+
+    #[test]
+    fn a_model_agrees_with_itself_on_every_base_code_and_not_with_another() {
+        let device = Device::flex();
+        let config = crate::model::generate::tests::tiny_vq();
+        let (a, b) = (config.init(&device), config.init(&device));
+        let set = motions();
+        assert_eq!(base_code_agreement(&a, &a, &set, &device, 10), 1.0);
+        let other = base_code_agreement(&a, &b, &set, &device, 10);
+        assert!(other < 0.9, "two random models agree on {other}");
+    }
 }

@@ -28,6 +28,10 @@ pub struct EvalArgs {
     /// likely code).
     #[arg(long, default_value_t = SamplingOptions::default().temperature)]
     temperature: f32,
+    /// Softmax temperature of the residual layers' codes in the spam row (0 takes the most
+    /// likely code).
+    #[arg(long, default_value_t = SamplingOptions::default().residual_temperature)]
+    residual_temperature: f32,
     /// Sample each code only among the K most likely in the spam row (default: all).
     #[arg(long)]
     top_k: Option<usize>,
@@ -86,6 +90,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
         sampling: SamplingOptions {
             base_guidance: args.guidance,
             temperature: args.temperature,
+            residual_temperature: args.residual_temperature,
             top_k: args.top_k,
             prior: args.prior_keep.map(|keep| PriorOptions {
                 keep,

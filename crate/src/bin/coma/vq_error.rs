@@ -33,6 +33,10 @@ pub struct VqErrorArgs {
     /// Also print how predictable each residual layer's codes are (entropies in nats).
     #[arg(long)]
     codes: bool,
+    /// Also print the share of layer-0 codes that these weights give the same as other
+    /// weights of the same sizes (e.g. the run a fine-tune started from).
+    #[arg(long)]
+    base_codes_of: Option<PathBuf>,
 }
 
 pub fn run(args: VqErrorArgs) -> Result<()> {
@@ -102,6 +106,15 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
                 l.layer, l.used, l.entropy, l.given_previous, l.given_first
             );
         }
+    }
+    if let Some(path) = &args.base_codes_of {
+        let other = coma::weights::load_file(cfg.model.init(&device), path)?;
+        let share = coma::train::vq::base_code_agreement(&model, &other, &set, &device, args.limit);
+        println!(
+            "layer-0 codes the same as {}'s: {:.1} %",
+            path.display(),
+            100.0 * share
+        );
     }
     Ok(())
 }
