@@ -282,6 +282,7 @@ fn every_source_builds_into_one_dataset_split_by_actor() {
             deepmimic: Some(shared.join("deepmimic")),
             out: out.clone(),
             limit: Some(30),
+            hdm05_test_actors: None,
         },
         &|_| {},
     )
@@ -338,6 +339,35 @@ fn every_source_builds_into_one_dataset_split_by_actor() {
         .captions
         .iter()
         .all(|c| c.contains("right") && !c.contains("left")));
+}
+
+#[test]
+fn other_hdm05_actors_can_be_held_out_for_testing() {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
+    let tmp = tempfile::tempdir().unwrap();
+    let summary = build(
+        &BuildOptions {
+            hdm05: Some(shared.join("hdm05-subset/hdm05-subset-amc.tar.xz")),
+            out: tmp.path().join("hdm05"),
+            hdm05_test_actors: Some(vec!["mm".into(), "bd".into()]),
+            ..Default::default()
+        },
+        &|_| {},
+    )
+    .unwrap();
+    let actors = |split| {
+        summary
+            .items
+            .iter()
+            .filter(|i| i.split == split)
+            .map(|i| i.actor.as_str())
+            .collect::<std::collections::BTreeSet<_>>()
+    };
+    assert_eq!(
+        actors(coma::dataset::Split::Test),
+        ["bd", "mm"].into_iter().collect()
+    );
+    assert!(actors(coma::dataset::Split::Train).contains("tr"));
 }
 
 #[test]

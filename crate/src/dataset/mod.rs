@@ -84,13 +84,18 @@ impl Source {
     }
 
     /// Which split a clip of this source goes to, when the source itself decides it: HDM05 by
-    /// actor, CMU by the source's own split, DeepMimic always training (one clip per action,
+    /// actor (`hdm05_test_actors` are held out for testing), CMU by the source's own split, DeepMimic always training (one clip per action,
     /// so holding one out would remove the action). `None` for Bandai-Namco, which is split
     /// by clip within each label ([`assign_splits`]).
-    pub fn split(self, actor: &str, source_test: bool) -> Option<Split> {
+    pub fn split(
+        self,
+        actor: &str,
+        source_test: bool,
+        hdm05_test_actors: &[String],
+    ) -> Option<Split> {
         match self {
             Source::Bandai => None,
-            Source::Hdm05 if HDM05_TEST_ACTORS.contains(&actor) => Some(Split::Test),
+            Source::Hdm05 if hdm05_test_actors.iter().any(|a| a == actor) => Some(Split::Test),
             Source::Cmu if source_test => Some(Split::Test),
             _ => Some(Split::Train),
         }
@@ -162,6 +167,10 @@ pub struct BuildOptions {
     pub out: PathBuf,
     /// Use only this many clips of each source, spread over it (for quick builds and tests).
     pub limit: Option<usize>,
+    /// HDM05 actors held out for testing instead of [`HDM05_TEST_ACTORS`]: how well the
+    /// networks carry over to a performer they never saw can be measured for other actors
+    /// (a dataset built so is for such measurements, not for the shipped model).
+    pub hdm05_test_actors: Option<Vec<String>>,
 }
 
 /// The record of one item in `dataset.json`.
@@ -475,6 +484,10 @@ fn read_sources(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Res
             motion: ClipMotion::Bvh(c.bvh),
         }));
     }
+    let hdm05_test_actors: Vec<String> = match &options.hdm05_test_actors {
+        Some(actors) => actors.clone(),
+        None => HDM05_TEST_ACTORS.iter().map(|a| a.to_string()).collect(),
+    };
     type Reader = fn(&Path) -> Result<Vec<mocap::Take>>;
     type Labeller = fn(&str) -> Option<labels::Reading>;
     let readers: [(&Option<PathBuf>, Reader, Labeller, &str); 3] = [
@@ -517,7 +530,7 @@ fn read_sources(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Res
             let source = Source::from(take.source);
             let source_test = mocap::cmu_expmap::source_split_is_test(&take.stem);
             let split = source
-                .split(&take.actor, source_test)
+                .split(&take.actor, source_test, &hdm05_test_actors)
                 .unwrap_or(Split::Train);
             clips.push(Clip {
                 source,

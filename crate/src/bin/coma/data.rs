@@ -37,6 +37,10 @@ enum DataCommand {
         /// Use only this many clips of each source, spread over it (quick builds).
         #[arg(long)]
         limit: Option<usize>,
+        /// HDM05 actors to hold out for testing (comma-separated, e.g. `mm,tr`) instead of
+        /// the usual one: measures how well the networks carry over to unseen performers.
+        #[arg(long, value_delimiter = ',')]
+        hdm05_test_actors: Option<Vec<String>>,
     },
 }
 
@@ -50,6 +54,7 @@ pub fn run(args: DataArgs) -> Result<()> {
             deepmimic,
             out,
             limit,
+            hdm05_test_actors,
         } => {
             let usual = |given: Option<PathBuf>, place: &str| {
                 given.or_else(|| {
@@ -66,6 +71,7 @@ pub fn run(args: DataArgs) -> Result<()> {
                 deepmimic: usual(deepmimic, "deepmimic"),
                 out: out.clone(),
                 limit,
+                hdm05_test_actors,
             };
             let summary = coma::dataset::build(&options, &|line| eprintln!("{line}"))?;
             println!(

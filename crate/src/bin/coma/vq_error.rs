@@ -27,6 +27,10 @@ pub struct VqErrorArgs {
     /// clips against its test clips without measuring the whole training split.
     #[arg(long)]
     source: Option<String>,
+    /// Only the motions whose item name contains this (e.g. `_mm_` for one HDM05 actor's
+    /// clips and their mirrors).
+    #[arg(long)]
+    name_contains: Option<String>,
     /// Also print the errors of each source's actions (their content labels).
     #[arg(long)]
     by_action: bool,
@@ -49,6 +53,12 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
         set = set.subset(|i| i.source.as_deref() == Some(source.as_str()));
         if set.items.is_empty() {
             bail!("the {split:?} split has no motions of the source '{source}'");
+        }
+    }
+    if let Some(part) = &args.name_contains {
+        set = set.subset(|i| i.name.contains(part.as_str()));
+        if set.items.is_empty() {
+            bail!("no motion of the {split:?} split has '{part}' in its name");
         }
     }
     let layers = args.layers.unwrap_or(cfg.model.layers);
