@@ -84,9 +84,10 @@ impl Source {
     }
 
     /// Which split a clip of this source goes to, when the source itself decides it: HDM05 by
-    /// actor (`hdm05_test_actors` are held out for testing), CMU by the source's own split, DeepMimic always training (one clip per action,
-    /// so holding one out would remove the action). `None` for Bandai-Namco, which is split
-    /// by clip within each label ([`assign_splits`]).
+    /// actor (`hdm05_test_actors` are held out for testing), CMU by the source's own split,
+    /// DeepMimic always training (one clip per action, so holding one out would remove the
+    /// action). `None` for Bandai-Namco, which is split by clip within each label
+    /// ([`assign_splits`]).
     pub fn split(
         self,
         actor: &str,
