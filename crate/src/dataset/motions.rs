@@ -134,16 +134,6 @@ pub struct CropDraw {
 }
 
 impl MotionSet {
-    /// A set of items already normalised by `normalizer`, drawn in proportion to their length
-    /// until [`MotionSet::balance`] says otherwise.
-    pub fn new(items: Vec<MotionItem>, normalizer: Normalizer) -> MotionSet {
-        MotionSet {
-            items,
-            normalizer,
-            cumulative: Vec::new(),
-        }
-    }
-
     /// The item's joint positions (metres, Y up, 20 fps), from its features.
     pub fn joints(&self, item: &MotionItem) -> Vec<Pose> {
         features::features_to_joints(&self.normalizer.denormalize(&item.features))
@@ -401,7 +391,7 @@ impl MotionSet {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// An item whose row `t` holds `t` in every column, so crops show where they came from.
@@ -441,12 +431,15 @@ mod tests {
     }
 
     /// The items with identity normalisation, drawn in proportion to their length.
-    fn plain_set(items: Vec<MotionItem>) -> MotionSet {
-        let identity = Normalizer {
-            mean: vec![0.0; FEATURE_DIM],
-            std: vec![1.0; FEATURE_DIM],
-        };
-        MotionSet::new(items, identity)
+    pub(crate) fn plain_set(items: Vec<MotionItem>) -> MotionSet {
+        MotionSet {
+            items,
+            normalizer: Normalizer {
+                mean: vec![0.0; FEATURE_DIM],
+                std: vec![1.0; FEATURE_DIM],
+            },
+            cumulative: Vec::new(),
+        }
     }
 
     #[test]

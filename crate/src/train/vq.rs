@@ -603,11 +603,7 @@ mod tests {
                 source: None,
             })
             .collect();
-        let identity = Normalizer {
-            mean: vec![0.0; FEATURE_DIM],
-            std: vec![1.0; FEATURE_DIM],
-        };
-        MotionSet::new(items, identity)
+        crate::dataset::motions::tests::plain_set(items)
     }
 
     #[test]
