@@ -165,6 +165,12 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
             Session::new(model, judge, Err("not used by the evaluation".into())).0
         });
     let spam = session.as_ref().map(Session::model);
+    if let (Some(model), Some(dir)) = (spam, options.spam) {
+        model
+            .spam
+            .check_sampling(&options.sampling)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    }
     let agent_options = &options.agents;
     let mut sources = vec![("real", Source::Real), ("retrieval", Source::Retrieval)];
     if let (Some(session), Some(model)) = (&session, spam) {

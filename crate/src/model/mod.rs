@@ -99,6 +99,20 @@ impl Spam {
             None => 1,
         }
     }
+
+    /// Refuses sampling options that ask for a retrieval prior this model does not have:
+    /// generation would silently run from the text alone, and a comparison made with them
+    /// would measure something other than it says.
+    pub fn check_sampling(&self, options: &generate::SamplingOptions) -> Result<(), String> {
+        match (&options.prior, &self.prior) {
+            (Some(asked), None) if asked.keep > 0.0 => Err(format!(
+                "the model has no retrieval prior (its spam.json has \"prior\": null), so keeping \
+                 {} of a retrieved motion's tokens cannot apply; add one with `coma export prior`",
+                asked.keep
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Sizes of SPAM's networks, stored beside their weights as `spam.json`. A model without a
@@ -413,5 +427,27 @@ mod tests {
         assert!(message(load(&undeclared, Some(&prior))).starts_with("prior.bin: present"));
         let cut = message(load(&config, Some(&prior[..prior.len() / 2])));
         assert!(cut.starts_with("prior.bin: "), "{cut}");
+    }
+
+    #[test]
+    fn asking_a_model_without_a_prior_to_keep_prior_tokens_is_an_error() {
+        use generate::tests::{small, tiny_vq};
+        let spam = Spam::random(&tiny_vq(), &small(), None, &Device::flex());
+        let with_keep = |keep| generate::SamplingOptions {
+            prior: Some(PriorOptions {
+                keep,
+                ..Default::default()
+            }),
+            ..Default::default()
+        };
+        let message = spam.check_sampling(&with_keep(0.2)).unwrap_err();
+        assert!(
+            message.starts_with("the model has no retrieval prior"),
+            "{message}"
+        );
+        assert!(message.contains("coma export prior"), "{message}");
+        // Turning the prior off, or leaving the model's own setting, asks for nothing absent.
+        assert!(spam.check_sampling(&with_keep(0.0)).is_ok());
+        assert!(spam.check_sampling(&Default::default()).is_ok());
     }
 }

@@ -582,6 +582,15 @@ impl MotionVq {
         self.decoder.forward(Tensor::cat(parts, 1)).swap_dims(1, 2)
     }
 
+    /// The decoder applied to the encoder's output itself, unquantized: the reconstruction
+    /// that ever more residual layers approach, so its error bounds what adding layers can
+    /// gain (a diagnostic; no token sequence decodes to it).
+    pub fn reconstruct_unquantized(&self, x: Tensor<3>) -> Tensor<3> {
+        self.decoder
+            .forward(Tensor::cat(self.encode(x), 1))
+            .swap_dims(1, 2)
+    }
+
     /// Encodes and decodes `x` with every layer (inference reconstruction).
     pub fn reconstruct(&self, x: Tensor<3>) -> Tensor<3> {
         self.decode(&self.tokenize(x))

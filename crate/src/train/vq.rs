@@ -363,7 +363,8 @@ impl ReconstructionError {
 }
 
 /// The errors of one motion reconstructed whole (cut to a multiple of 4 frames) from its
-/// first `layers` residual layers; `None` for a motion shorter than one token.
+/// first `layers` residual layers (0: from the encoder's output unquantized); `None` for a
+/// motion shorter than one token.
 fn motion_error(
     model: &MotionVq,
     item: &[FeatureFrame],
@@ -379,16 +380,20 @@ fn motion_error(
     let x = batch_tensor(frames.iter().flatten().copied().collect(), 1, t, device);
     // Only the first `layers` residual layers: what a decoder sees when the later layers
     // are left out (quantisation dropout trained it for that).
-    let tokens: Vec<_> = model
-        .tokenize(x)
-        .into_iter()
-        .map(|mut part| {
-            part.truncate(layers.max(1));
-            part
-        })
-        .collect();
-    let y: Vec<f32> = model
-        .decode(&tokens)
+    let y = if layers == 0 {
+        model.reconstruct_unquantized(x)
+    } else {
+        let tokens: Vec<_> = model
+            .tokenize(x)
+            .into_iter()
+            .map(|mut part| {
+                part.truncate(layers);
+                part
+            })
+            .collect();
+        model.decode(&tokens)
+    };
+    let y: Vec<f32> = y
         .try_into_vec_as::<f32>()
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
     let recon: Vec<FeatureFrame> = y

@@ -191,6 +191,10 @@ fn action_probe(generator: &MotionModel, probe: &ActionProbe, args: ActionArgs) 
             }),
         ..Default::default()
     };
+    generator
+        .spam
+        .check_sampling(&options)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.model.models.display()))?;
     let sampling = match args.top_k {
         Some(k) => format!(", top-k {k}, temperature {}", args.temperature),
         None => format!(", temperature {}", args.temperature),

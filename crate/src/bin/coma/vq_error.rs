@@ -20,7 +20,8 @@ pub struct VqErrorArgs {
     /// At most this many motions.
     #[arg(long, default_value_t = 100000)]
     limit: usize,
-    /// Decode from the first N residual layers only (default: all).
+    /// Decode from the first N residual layers only (default: all); 0 decodes the encoder's
+    /// output unquantized, the bound that more residual layers approach.
     #[arg(long)]
     layers: Option<usize>,
     /// Only the motions of this source (bandai, hdm05, cmu, deepmimic): a source's training
@@ -62,6 +63,12 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
         }
     }
     let layers = args.layers.unwrap_or(cfg.model.layers);
+    if layers > cfg.model.layers {
+        bail!(
+            "--layers {layers}: the model has {} residual layers",
+            cfg.model.layers
+        );
+    }
     let by_action = args.by_action;
     let (e, groups) = coma::train::vq::reconstruction_errors_by(
         &model,
@@ -78,8 +85,16 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
         },
     )?;
     println!(
-        "{} motions of the {:?} split, {layers} of {} layers: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned), {:.1} mm (posture: pelvis-relative, in the body's facing frame)",
-        e.motions, split, cfg.model.layers, e.global_mm, e.root_aligned_mm, e.posture_mm
+        "{} motions of the {:?} split, {}: mean per-joint position error {:.1} mm (root path integrated), {:.1} mm (root aligned), {:.1} mm (posture: pelvis-relative, in the body's facing frame)",
+        e.motions,
+        split,
+        match layers {
+            0 => "unquantized".to_string(),
+            n => format!("{n} of {} layers", cfg.model.layers),
+        },
+        e.global_mm,
+        e.root_aligned_mm,
+        e.posture_mm
     );
     // Per source, then (with --by-action) its actions under it.
     let mut sources: std::collections::BTreeMap<&str, coma::train::vq::ReconstructionError> =
