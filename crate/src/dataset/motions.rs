@@ -3,9 +3,10 @@
 
 use crate::dataset::Split;
 use crate::features::{self, FeatureFrame, Normalizer, FEATURE_DIM};
+use crate::geom::{self, Quat};
 use crate::npy::NpyArray;
 use crate::rng::Rng;
-use crate::skeleton::{BodyPart, Pose};
+use crate::skeleton::{BodyPart, Pose, NUM_JOINTS};
 use anyhow::{bail, Context, Result};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -107,18 +108,40 @@ pub struct CropSpec {
     /// The largest speed factor of a replay: factors are drawn log-uniformly in
     /// `[1 / retime_max, retime_max]`; 1 replays nothing.
     pub retime_max: f64,
+    /// Chance that a crop is performed with another posture habit
+    /// ([`features::vary_posture`]), in 0..=1.
+    pub posture_chance: f64,
+    /// The largest turn of one bone in such a crop, in degrees: each bone turns about a
+    /// random axis by an angle drawn uniformly up to it (chains add up).
+    pub posture_degrees: f64,
 }
 
 impl CropSpec {
-    /// Crops of at most `max_frames`, in multiples of `multiple`, at the captured speed.
+    /// Crops of at most `max_frames`, in multiples of `multiple`, at the captured speed and
+    /// posture.
     pub fn plain(max_frames: usize, multiple: usize) -> CropSpec {
         CropSpec {
             max_frames,
             multiple,
             retime_chance: 0.0,
             retime_max: 1.0,
+            posture_chance: 0.0,
+            posture_degrees: 0.0,
         }
     }
+}
+
+/// Turns of every bone for [`features::vary_posture`]: each about an axis drawn uniformly on
+/// the sphere, by an angle drawn uniformly in `[0, max_degrees]`.
+pub fn random_turns(rng: &mut Rng, max_degrees: f64) -> [Quat; NUM_JOINTS] {
+    std::array::from_fn(|_| {
+        let axis = [rng.normal(), rng.normal(), rng.normal()].map(f64::from);
+        let angle = (max_degrees * rng.uniform() as f64).to_radians();
+        match geom::norm(axis) {
+            n if n > 1e-9 => Quat::from_axis_angle(geom::scale(axis, 1.0 / n), angle),
+            _ => Quat::IDENTITY,
+        }
+    })
 }
 
 /// One crop of a batch: where it comes from and how many of its frames are the motion's.
@@ -375,6 +398,21 @@ impl MotionSet {
                 rows.truncate(draw.real);
                 rows
             };
+            // Drawn only when asked for, so runs without it sample what they always did.
+            let rows = if spec.posture_degrees > 0.0
+                && (rng.uniform() as f64) < spec.posture_chance
+                && rows.len() >= 2
+            {
+                let turns = random_turns(rng, spec.posture_degrees);
+                let varied = features::vary_posture(&self.normalizer.denormalize(&rows), &turns);
+                // Rows that describe no joints (never in a built dataset) stay as they are.
+                match varied.len() == rows.len() {
+                    true => self.normalizer.normalize(&varied),
+                    false => rows,
+                }
+            } else {
+                rows
+            };
             for t in 0..frames {
                 data.extend_from_slice(&rows[t.min(rows.len() - 1)]);
                 mask.push((t < rows.len()) as u8 as f32);
@@ -506,6 +544,26 @@ pub(crate) mod tests {
             (batch.frames, batch.mask[..4].to_vec()),
             (4, vec![1.0, 1.0, 0.0, 0.0])
         );
+    }
+
+    #[test]
+    fn posture_turns_stay_within_their_largest_angle_about_spread_axes() {
+        let mut rng = Rng::new(11);
+        let turns: Vec<Quat> = (0..50).flat_map(|_| random_turns(&mut rng, 8.0)).collect();
+        let angles: Vec<f64> = turns
+            .iter()
+            .map(|q| 2.0 * q.0[0].clamp(-1.0, 1.0).acos().to_degrees())
+            .collect();
+        assert!(angles.iter().all(|a| *a <= 8.0 + 1e-9), "{angles:?}");
+        let mean = angles.iter().sum::<f64>() / angles.len() as f64;
+        assert!((mean - 4.0).abs() < 0.5, "mean turn {mean}°");
+        // Axes point every way: their mean (weighted by the turn) is near zero.
+        let axis_sum = turns
+            .iter()
+            .fold([0.0; 3], |acc, q| geom::add(acc, [q.0[1], q.0[2], q.0[3]]));
+        let per_turn = geom::norm(axis_sum) / turns.len() as f64;
+        assert!(per_turn < 0.005, "mean axis {per_turn}");
+        assert_eq!(random_turns(&mut rng, 0.0), [Quat::IDENTITY; NUM_JOINTS]);
     }
 
     #[test]

@@ -367,6 +367,55 @@ pub fn retime(features: &[FeatureFrame], speed: f64) -> Features {
         .collect()
 }
 
+/// The same motion performed with another posture habit: the bone of joint `j` (from its
+/// parent) is turned by `turns[j]` in the body's facing frame, and every turn is carried
+/// down its chain, so a turned spine takes the head and the arms with it, as a different
+/// performer's stoop would. Bone lengths, the root path and the pelvis height stay; the
+/// rotations, velocities and foot contacts are computed again from the new joints (features,
+/// not normalised; `turns[0]` is ignored). Training uses it to show a model performers its
+/// few actors are not: the HDM05 actors' resting stances differ by 20–40 mm a joint on
+/// average. Returns as many rows as given (none for a motion of fewer than 2 rows).
+pub fn vary_posture(features: &[FeatureFrame], turns: &[Quat; NUM_JOINTS]) -> Features {
+    if features.len() < 2 {
+        return Vec::new();
+    }
+    let (rots, _) = recover_root(features);
+    let mut chain = [Quat::IDENTITY; NUM_JOINTS];
+    for j in 1..NUM_JOINTS {
+        let parent = skeleton::PARENTS[j].expect("non-root joint has a parent");
+        chain[j] = chain[parent].mul(turns[j]);
+    }
+    let poses: Vec<Pose> = features_to_joints_with_final(features)
+        .iter()
+        .enumerate()
+        .map(|(t, pose)| {
+            // The final pose (reached by the last row's velocities) keeps the last facing.
+            let facing = rots[t.min(rots.len() - 1)];
+            let mut varied = *pose;
+            for j in 1..NUM_JOINTS {
+                let parent = skeleton::PARENTS[j].expect("non-root joint has a parent");
+                let bone = facing.rotate(geom::sub(pose[j], pose[parent]));
+                let turned = facing.inv().rotate(chain[j].rotate(bone));
+                varied[j] = geom::add(varied[parent], turned);
+            }
+            varied
+        })
+        .collect();
+    let Ok((mut rows, _)) = joints_to_features(&poses, &Offsets::from_pose(&poses[0])) else {
+        return Vec::new();
+    };
+    // `joints_to_features` puts the lowest joint of these frames on the floor; a stretch in
+    // the air (a crop of a jump) stays at the height it was captured at.
+    let lift = features[0][ROOT_HEIGHT.start] - rows[0][ROOT_HEIGHT.start];
+    for row in &mut rows {
+        row[ROOT_HEIGHT.start] += lift;
+        for j in 1..NUM_JOINTS {
+            row[POSITIONS.start + (j - 1) * 3 + 1] += lift;
+        }
+    }
+    rows
+}
+
 /// Rows that [`retime`] makes of `rows` rows at `speed` (positive): `⌊(rows − 1) / speed⌋ + 1`.
 pub fn retimed_rows(rows: usize, speed: f64) -> usize {
     match rows {
@@ -686,6 +735,52 @@ mod tests {
                 / f.len() as f32
         };
         assert!(contacts(&retime(&feats, 3.0)) <= contacts(&feats));
+    }
+
+    #[test]
+    fn a_varied_posture_turns_the_asked_bones_and_their_chains_only() {
+        let poses = synthetic(30);
+        let target = Offsets::from_pose(&poses[0]);
+        let (feats, _) = joints_to_features(&poses, &target).unwrap();
+        let joints = features_to_joints(&feats);
+        // No turn: the same joints, to float precision.
+        let same = features_to_joints(&vary_posture(&feats, &[Quat::IDENTITY; NUM_JOINTS]));
+        assert_eq!(same.len(), joints.len());
+        assert!(skeleton::max_joint_distance(&same, &joints) < 1e-4);
+        // The left elbow turned by 10°: the left wrist moves by the chord of 10° at the
+        // forearm's length, the rest of the body and the pelvis height stay.
+        let mut turns = [Quat::IDENTITY; NUM_JOINTS];
+        turns[joint::L_WRIST] = Quat::from_axis_angle([0.0, 0.0, 1.0], 10f64.to_radians());
+        let varied = vary_posture(&feats, &turns);
+        assert_eq!(varied.len(), feats.len());
+        let moved = features_to_joints(&varied);
+        let forearm = geom::dist(joints[0][joint::L_WRIST], joints[0][joint::L_ELBOW]);
+        let chord = 2.0 * forearm * 5f64.to_radians().sin();
+        for (t, (a, b)) in joints.iter().zip(&moved).enumerate() {
+            let relative = |p: &Pose, j: usize| geom::sub(p[j], p[0]);
+            let shift = geom::dist(relative(a, joint::L_WRIST), relative(b, joint::L_WRIST));
+            assert!(
+                (shift - chord).abs() < 2e-3,
+                "frame {t}: {shift} against {chord}"
+            );
+            for j in (0..NUM_JOINTS).filter(|&j| j != joint::L_WRIST) {
+                let d = geom::dist(relative(a, j), relative(b, j));
+                assert!(d < 1e-3, "frame {t} joint {j} moved {d}");
+            }
+            assert!((a[0][1] - b[0][1]).abs() < 1e-4, "frame {t} pelvis height");
+        }
+        // A turned spine carries the head and both wrists.
+        let mut turns = [Quat::IDENTITY; NUM_JOINTS];
+        turns[joint::SPINE2] = Quat::from_axis_angle([1.0, 0.0, 0.0], 10f64.to_radians());
+        let stooped = features_to_joints(&vary_posture(&feats, &turns));
+        for j in [joint::HEAD, joint::L_WRIST, joint::R_WRIST] {
+            let d = geom::dist(
+                geom::sub(stooped[5][j], stooped[5][0]),
+                geom::sub(joints[5][j], joints[5][0]),
+            );
+            assert!(d > 0.01, "joint {j} moved only {d}");
+        }
+        assert!(vary_posture(&feats[..1], &turns).is_empty());
     }
 
     #[test]

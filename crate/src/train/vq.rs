@@ -36,6 +36,14 @@ pub struct VqTrainingConfig {
     /// The largest speed factor of a replayed crop (factors log-uniform in `[1/max, max]`).
     #[config(default = 1.25)]
     pub retime_max: f64,
+    /// Chance that a crop is performed with another posture habit
+    /// (`features::vary_posture`): stances and reaches the few actors of the small sources
+    /// did not show. 0 varies nothing.
+    #[config(default = 0.0)]
+    pub posture_chance: f64,
+    /// The largest turn of one bone in a varied crop, in degrees.
+    #[config(default = 6.0)]
+    pub posture_degrees: f64,
     /// How strongly crops favour rare actions (see `MotionSet::balance`: 0 draws in
     /// proportion to length, 1 gives every action the same share).
     #[config(default = 0.0)]
@@ -160,6 +168,8 @@ pub fn train_vq(
     let spec = CropSpec {
         retime_chance: config.retime_chance,
         retime_max: config.retime_max,
+        posture_chance: config.posture_chance,
+        posture_degrees: config.posture_degrees,
         ..CropSpec::plain(config.max_frames, FRAMES_PER_TOKEN)
     };
     progress(&format!(
