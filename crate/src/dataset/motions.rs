@@ -137,9 +137,10 @@ pub fn random_turns(rng: &mut Rng, max_degrees: f64) -> [Quat; NUM_JOINTS] {
     std::array::from_fn(|_| {
         let axis = [rng.normal(), rng.normal(), rng.normal()].map(f64::from);
         let angle = (max_degrees * rng.uniform() as f64).to_radians();
-        match geom::norm(axis) {
-            n if n > 1e-9 => Quat::from_axis_angle(geom::scale(axis, 1.0 / n), angle),
-            _ => Quat::IDENTITY,
+        // A zero axis (never drawn in practice) would give no unit quaternion.
+        match geom::norm(axis) > 1e-9 {
+            true => Quat::from_axis_angle(axis, angle),
+            false => Quat::IDENTITY,
         }
     })
 }
@@ -384,34 +385,32 @@ impl MotionSet {
         let mut mask = Vec::with_capacity(batch * frames);
         for draw in &sources {
             let item = &self.items[draw.item].features;
-            let rows = if draw.speed == 1.0 {
+            // Drawn only when asked for, so runs without it sample what they always did.
+            let turns = (spec.posture_degrees > 0.0
+                && (rng.uniform() as f64) < spec.posture_chance
+                && draw.real >= 2)
+                .then(|| random_turns(rng, spec.posture_degrees));
+            let rows = if draw.speed == 1.0 && turns.is_none() {
                 item[draw.start..draw.start + draw.real].to_vec()
             } else {
+                // Both replays work on denormalised rows, normalised once at the end.
                 let span =
                     features::source_rows(draw.real, draw.speed).min(item.len() - draw.start);
-                let window = self
+                let mut raw = self
                     .normalizer
                     .denormalize(&item[draw.start..draw.start + span]);
-                let mut rows = self
-                    .normalizer
-                    .normalize(&features::retime(&window, draw.speed));
-                rows.truncate(draw.real);
-                rows
-            };
-            // Drawn only when asked for, so runs without it sample what they always did.
-            let rows = if spec.posture_degrees > 0.0
-                && (rng.uniform() as f64) < spec.posture_chance
-                && rows.len() >= 2
-            {
-                let turns = random_turns(rng, spec.posture_degrees);
-                let varied = features::vary_posture(&self.normalizer.denormalize(&rows), &turns);
-                // Rows that describe no joints (never in a built dataset) stay as they are.
-                match varied.len() == rows.len() {
-                    true => self.normalizer.normalize(&varied),
-                    false => rows,
+                if draw.speed != 1.0 {
+                    raw = features::retime(&raw, draw.speed);
+                    raw.truncate(draw.real);
                 }
-            } else {
-                rows
+                if let Some(turns) = &turns {
+                    let varied = features::vary_posture(&raw, turns);
+                    // Rows that describe no joints (never in a built dataset) stay as they are.
+                    if varied.len() == raw.len() {
+                        raw = varied;
+                    }
+                }
+                self.normalizer.normalize(&raw)
             };
             for t in 0..frames {
                 data.extend_from_slice(&rows[t.min(rows.len() - 1)]);
