@@ -656,6 +656,26 @@ mod tests {
     }
 
     #[test]
+    fn the_unquantized_reconstruction_does_not_depend_on_the_codebooks() {
+        let device = Device::flex();
+        let config = small().with_quantize_dropout(0.0);
+        let mut vq = config.init(&device);
+        let x = motion(2, 16, &device);
+        let (plain, coded) = (
+            vq.reconstruct_unquantized(x.clone()),
+            vq.reconstruct(x.clone()),
+        );
+        assert_eq!(plain.dims(), [2, 16, FEATURE_DIM]);
+        // Decay 0 replaces every used code by the mean of what it quantized.
+        let mut rng = Rng::new(3);
+        let out = vq.forward_train(x.clone(), None, &config, &mut rng);
+        vq.update_codebooks(&out.assignments, 0.0, &mut rng);
+        let gap = |a: Tensor<3>, b: Tensor<3>| (a - b).abs().max().into_scalar::<f32>();
+        assert!(gap(vq.reconstruct_unquantized(x.clone()), plain) < 1e-6);
+        assert!(gap(vq.reconstruct(x), coded) > 1e-4, "the codes moved");
+    }
+
+    #[test]
     fn padded_tokens_neither_commit_nor_move_the_codebooks() {
         let device = Device::flex();
         let config = small().with_quantize_dropout(0.0);
