@@ -184,7 +184,7 @@ fn train_vq_rate(config: &SpamConfig, steps: usize) -> f64 {
         let loss = (out.reconstruction - x).abs().mean() + out.commitment * 0.02;
         let grads = GradientsParams::from_grads(loss.backward(), &model);
         model = optim.step(1e-4, model, grads);
-        model.update_codebooks(&out.assignments, config.vq.ema_decay, &mut rng);
+        model.update_codebooks(&out.assignments, config.vq.ema_decay, 0, &mut rng);
         if i > 0 {
             elapsed += start.elapsed().as_secs_f64();
         }

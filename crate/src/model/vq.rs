@@ -245,6 +245,16 @@ impl ResidualQuantizer {
         dist.argmin(1).reshape([m])
     }
 
+    /// Negative squared distances of each row of `x` (`[M, D]`) to the codes of `layer`
+    /// (`[M, K]`): logits whose argmax is the code the layer would choose, with a gradient
+    /// to `x` (the codebook is held).
+    pub fn code_logits(&self, x: Tensor<2>, layer: usize) -> Tensor<2> {
+        let codebook = self.codebook(layer);
+        let x_sq = x.clone().powi_scalar(2).sum_dim(1);
+        let c_sq = codebook.clone().powi_scalar(2).sum_dim(1).transpose();
+        x.matmul(codebook.transpose()) * 2.0 - x_sq - c_sq
+    }
+
     /// Quantizes `z` (`[M, D]`) with the first `active` layers. Returns the summed code
     /// vectors (no gradient), the codes per layer (`[M]` each) and what each layer saw.
     pub fn quantize(&self, z: Tensor<2>, active: usize) -> (Tensor<2>, Vec<LayerAssignment>) {
@@ -280,8 +290,15 @@ impl ResidualQuantizer {
 
     /// Moving-average codebook update from one step's assignments; codes that receive (on
     /// average) less than one vector are reset to random vectors of this batch, so no code
-    /// stays dead. Returns the number of codes reset.
-    pub fn update(&mut self, assignments: &[LayerAssignment], decay: f64, rng: &mut Rng) -> usize {
+    /// stays dead. The first `held_layers` layers keep their codes and averages. Returns the
+    /// number of codes reset.
+    pub fn update(
+        &mut self,
+        assignments: &[LayerAssignment],
+        decay: f64,
+        held_layers: usize,
+        rng: &mut Rng,
+    ) -> usize {
         let [layers, k, d] = self.codebooks.val().dims();
         let device = self.codebooks.val().device();
         let mut books = Vec::with_capacity(layers);
@@ -301,8 +318,8 @@ impl ResidualQuantizer {
                 .narrow(0, layer, 1)
                 .reshape([k, d])
                 .detach();
-            let Some(a) = assignments.get(layer) else {
-                // Layer unused this step (quantization dropout): keep it as it is.
+            let Some(a) = assignments.get(layer).filter(|_| layer >= held_layers) else {
+                // Layer held, or unused this step (quantization dropout): keep it as it is.
                 books.push(self.codebook(layer));
                 counts_all.push(old_counts);
                 sums_all.push(old_sums);
@@ -371,6 +388,9 @@ pub struct VqTrainOutput {
     pub commitment: Tensor<1>,
     /// Per part, what each active layer did (for the codebook update).
     pub assignments: Vec<Vec<LayerAssignment>>,
+    /// Per part, the encoder's output as `[B·N, D]` rows (time-major within each motion),
+    /// with its gradient: what [`MotionVq::base_code_loss`] pulls toward given codes.
+    pub encodings: Vec<Tensor<2>>,
 }
 
 impl VqConfig {
@@ -464,9 +484,11 @@ impl MotionVq {
         let mut parts = Vec::with_capacity(4);
         let mut commitment: Option<Tensor<1>> = None;
         let mut assignments = Vec::with_capacity(4);
+        let mut encodings = Vec::with_capacity(4);
         for (z, quantizer) in self.encode(x).into_iter().zip(&self.quantizers) {
             let [b, _, n] = z.dims();
             let rows = Self::rows(z);
+            encodings.push(rows.clone());
             let (q, layers) = quantizer.quantize(rows.clone(), active);
             let layers = layers
                 .into_iter()
@@ -493,7 +515,43 @@ impl MotionVq {
             reconstruction,
             commitment: commitment.expect("four parts") / 4.0,
             assignments,
+            encodings,
         }
+    }
+
+    /// How far the encoder's outputs (`encodings`, per part `[M, D]` rows) are from choosing
+    /// the layer-0 codes `targets` (per part `[M]`): the cross-entropy of their distances to
+    /// codebook 0, which vanishes once each output sits well inside its target's cell, and
+    /// the share of rows that already choose their target. With codebook 0 held, it lets the
+    /// encoder learn while every layer-0 token, the base transformer's vocabulary, stays.
+    pub fn base_code_loss(
+        &self,
+        encodings: &[Tensor<2>],
+        targets: &[Tensor<1, Int>],
+    ) -> (Tensor<1>, f64) {
+        let (mut loss, mut kept, mut rows) = (None::<Tensor<1>>, 0usize, 0usize);
+        for ((z, target), quantizer) in encodings.iter().zip(targets).zip(&self.quantizers) {
+            let logits = quantizer.code_logits(z.clone(), 0);
+            let [m, _] = logits.dims();
+            let chosen = logits.clone().argmax(1).reshape([m]);
+            kept += chosen
+                .equal(target.clone())
+                .int()
+                .sum()
+                .into_scalar::<i64>() as usize;
+            rows += m;
+            let part = burn::nn::loss::CrossEntropyLossConfig::new()
+                .init(&z.device())
+                .forward(logits, target.clone());
+            loss = Some(match loss {
+                None => part,
+                Some(sum) => sum + part,
+            });
+        }
+        (
+            loss.expect("four parts") / encodings.len() as f64,
+            kept as f64 / rows.max(1) as f64,
+        )
     }
 
     /// The reconstruction of `x` `[B, T, 263]` from its first `layers` token layers, with the
@@ -596,17 +654,19 @@ impl MotionVq {
         self.decode(&self.tokenize(x))
     }
 
-    /// Moving-average update of every codebook after a training step. Returns codes reset.
+    /// Moving-average update of every codebook after a training step, the first
+    /// `held_layers` layers of each part left as they are. Returns codes reset.
     pub fn update_codebooks(
         &mut self,
         assignments: &[Vec<LayerAssignment>],
         decay: f64,
+        held_layers: usize,
         rng: &mut Rng,
     ) -> usize {
         self.quantizers
             .iter_mut()
             .zip(assignments)
-            .map(|(q, a)| q.update(a, decay, rng))
+            .map(|(q, a)| q.update(a, decay, held_layers, rng))
             .sum()
     }
 }
@@ -669,7 +729,7 @@ mod tests {
         // Decay 0 replaces every used code by the mean of what it quantized.
         let mut rng = Rng::new(3);
         let out = vq.forward_train(x.clone(), None, &config, &mut rng);
-        vq.update_codebooks(&out.assignments, 0.0, &mut rng);
+        vq.update_codebooks(&out.assignments, 0.0, 0, &mut rng);
         let gap = |a: Tensor<3>, b: Tensor<3>| (a - b).abs().max().into_scalar::<f32>();
         assert!(gap(vq.reconstruct_unquantized(x.clone()), plain) < 1e-6);
         assert!(gap(vq.reconstruct(x), coded) > 1e-4, "the codes moved");
@@ -735,7 +795,7 @@ mod tests {
             losses.push(loss.clone().into_scalar::<f32>());
             let grads = burn::optim::GradientsParams::from_grads(loss.backward(), &vq);
             vq = optim.step(3e-3, vq, grads);
-            vq.update_codebooks(&out.assignments, config.ema_decay, &mut rng);
+            vq.update_codebooks(&out.assignments, config.ema_decay, 0, &mut rng);
         }
         let late = losses[35..].iter().sum::<f32>() / 5.0;
         assert!(late < losses[0] * 0.8, "{losses:?}");
@@ -776,5 +836,86 @@ mod tests {
         assert_eq!(tokens(&vq), first_tokens, "the encoder and codebooks stay");
         let moved = (vq.reconstruct(x.clone()) - first_decode).abs().max();
         assert!(moved.into_scalar::<f32>() > 1e-4, "the decoder changed");
+    }
+
+    #[test]
+    fn the_base_code_loss_is_low_on_its_targets_and_counts_what_is_kept() {
+        let device = Device::flex();
+        let vq = small().init(&device);
+        let codes = [3i32, 17, 9, 3];
+        let picks = Tensor::<1, Int>::from_data(TensorData::new(codes.to_vec(), [4]), &device);
+        let on_codes: Vec<Tensor<2>> = vq
+            .quantizers
+            .iter()
+            .map(|q| q.codebook(0).select(0, picks.clone()))
+            .collect();
+        let targets = |codes: [i32; 4]| -> Vec<Tensor<1, Int>> {
+            (0..4)
+                .map(|_| Tensor::from_data(TensorData::new(codes.to_vec(), [4]), &device))
+                .collect()
+        };
+        let (right, kept) = vq.base_code_loss(&on_codes, &targets(codes));
+        let (wrong, none) = vq.base_code_loss(&on_codes, &targets([5, 6, 7, 8]));
+        assert_eq!((kept, none), (1.0, 0.0));
+        let (right, wrong) = (right.into_scalar::<f32>(), wrong.into_scalar::<f32>());
+        assert!(right < 0.1 && wrong > 1.0, "{right} {wrong}");
+    }
+
+    #[test]
+    fn holding_layer_0_keeps_its_codes_while_the_rest_learns() {
+        let device = Device::flex().autodiff();
+        let config = small().with_quantize_dropout(0.0);
+        let mut vq = config.init(&device);
+        let anchor = vq.valid();
+        let mut optim = burn::optim::AdamConfig::new().init();
+        let mut rng = Rng::new(7);
+        let x = motion(4, 16, &device);
+        let books = |vq: &MotionVq, layer: usize| -> Vec<f32> {
+            vq.quantizers[1]
+                .codebook(layer)
+                .try_into_vec_as::<f32>()
+                .unwrap()
+        };
+        let layer0 = |vq: &MotionVq| -> Vec<Vec<i64>> {
+            vq.valid()
+                .tokenize(x.clone().without_autodiff())
+                .into_iter()
+                .map(|layers| layers[0].clone().try_into_vec_as::<i64>().unwrap())
+                .collect()
+        };
+        let (first0, first1, first_codes) = (books(&vq, 0), books(&vq, 1), layer0(&vq));
+        let first_encoding = vq.encode(x.clone())[0].clone();
+        for _ in 0..30 {
+            let out = vq.forward_train(x.clone(), None, &config, &mut rng);
+            let targets: Vec<Tensor<1, Int>> = anchor
+                .tokenize(x.clone().without_autodiff())
+                .into_iter()
+                .map(|layers| {
+                    Tensor::from_data(layers[0].clone().reshape([16]).into_data(), &device)
+                })
+                .collect();
+            let (base, _) = vq.base_code_loss(&out.encodings, &targets);
+            let loss = (out.reconstruction - x.clone()).abs().mean() + base;
+            let grads = burn::optim::GradientsParams::from_grads(loss.backward(), &vq);
+            vq = optim.step(3e-3, vq, grads);
+            vq.update_codebooks(&out.assignments, config.ema_decay, 1, &mut rng);
+        }
+        assert_eq!(books(&vq, 0), first0, "codebook 0 is held");
+        assert_ne!(books(&vq, 1), first1, "codebook 1 learns");
+        let moved = (vq.encode(x.clone())[0].clone() - first_encoding)
+            .abs()
+            .max();
+        assert!(moved.into_scalar::<f32>() > 1e-3, "the encoder learns");
+        let (now, same): (Vec<i64>, Vec<bool>) = (
+            layer0(&vq).concat(),
+            layer0(&vq)
+                .concat()
+                .iter()
+                .zip(first_codes.concat())
+                .map(|(a, b)| *a == b)
+                .collect(),
+        );
+        let kept = same.iter().filter(|s| **s).count() as f64 / now.len() as f64;
+        assert!(kept >= 0.9, "layer-0 codes kept: {kept}");
     }
 }

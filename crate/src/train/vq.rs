@@ -79,6 +79,14 @@ pub struct VqTrainingConfig {
     /// same and transformers trained on them still fit. 0 trains everything.
     #[config(default = 0)]
     pub decoder_only_layers: usize,
+    /// Above 0, holds the layer-0 tokens where `--init` put them while everything else
+    /// learns: codebook 0 stays as it is, and the encoder is pulled, with this weight, toward
+    /// the layer-0 code that `--init`'s encoder chooses for the same crop
+    /// ([`MotionVq::base_code_loss`]). The residual layers carry what the encoder learns, so
+    /// the VQ-VAE improves without retraining a base transformer on new tokens. 0 lets
+    /// layer 0 move.
+    #[config(default = 0.0)]
+    pub base_code_weight: f64,
     #[config(default = 5.0)]
     pub checkpoint_minutes: f64,
     /// Steps between progress lines.
@@ -151,16 +159,18 @@ pub fn train_vq(
                 v.items.len()
             ))
     ));
-    let (mut run, resumed) = Run::open(
-        &options.run_dir,
-        &[
-            "loss",
-            "reconstruction",
-            "commitment",
-            "heading",
-            "codes_reset",
-        ],
-    )?;
+    let holds_base = config.base_code_weight > 0.0 && config.decoder_only_layers == 0;
+    let mut columns = vec![
+        "loss",
+        "reconstruction",
+        "commitment",
+        "heading",
+        "codes_reset",
+    ];
+    if holds_base {
+        columns.extend(["base_codes", "base_codes_kept"]);
+    }
+    let (mut run, resumed) = Run::open(&options.run_dir, &columns)?;
     config
         .save(options.run_dir.join("config.json"))
         .context("saving config.json")?;
@@ -193,6 +203,18 @@ pub fn train_vq(
         resumed,
         progress,
     )?;
+    // The encoder whose layer-0 codes are held: `--init`'s, on every resumption too.
+    let plain = device.clone().without_autodiff();
+    let anchor = match (holds_base, options.init.as_deref()) {
+        (false, _) => None,
+        (true, None) => anyhow::bail!(
+            "base_code_weight holds the layer-0 codes of the weights a run starts from: give --init"
+        ),
+        (true, Some(path)) => Some(
+            crate::weights::load_file(config.model.init(&plain), path)
+                .with_context(|| format!("loading the held codes' VQ-VAE {}", path.display()))?,
+        ),
+    };
     let mut optim = AdamWConfig::new()
         .with_weight_decay(0.0)
         .with_grad_clipping(Some(GradientClippingConfig::Norm(1.0)))
@@ -227,6 +249,7 @@ pub fn train_vq(
                 reconstruction: model.forward_decoder_train(x.clone(), decoder_only),
                 commitment: Tensor::zeros([1], device),
                 assignments: Vec::new(),
+                encodings: Vec::new(),
             }
         } else {
             model.forward_train(x.clone(), Some(&real_frames), &config.model, &mut rng)
@@ -262,13 +285,30 @@ pub fn train_vq(
             heading_l1.forward(turn_error.cumsum(1), Tensor::zeros([b, t, 1], device)),
             mask,
         );
-        let loss = recon.clone()
+        let mut loss = recon.clone()
             + positions * config.position_weight
             + velocity * config.velocity_weight
             + heading.clone() * config.heading_weight
             + out.commitment.clone() * config.commitment;
+        let base = anchor.as_ref().map(|anchor| {
+            let targets: Vec<Tensor<1, Int>> = anchor
+                .tokenize(x.clone().without_autodiff())
+                .into_iter()
+                .map(|mut layers| {
+                    let codes = layers.swap_remove(0);
+                    Tensor::from_data(
+                        codes.reshape([b * (t / FRAMES_PER_TOKEN)]).into_data(),
+                        device,
+                    )
+                })
+                .collect();
+            model.base_code_loss(&out.encodings, &targets)
+        });
+        if let Some((base_loss, _)) = &base {
+            loss = loss + base_loss.clone() * config.base_code_weight;
+        }
 
-        let values = [
+        let mut values = vec![
             loss.clone().into_scalar::<f32>() as f64,
             recon.into_scalar::<f32>() as f64,
             out.commitment.clone().into_scalar::<f32>() as f64,
@@ -284,10 +324,18 @@ pub fn train_vq(
         let reset = if decoder_only > 0 {
             0
         } else {
-            model.update_codebooks(&out.assignments, config.model.ema_decay, &mut rng)
+            model.update_codebooks(
+                &out.assignments,
+                config.model.ema_decay,
+                holds_base as usize,
+                &mut rng,
+            )
         };
-        let logged = [values[0], values[1], values[2], values[3], reset as f64];
-        run.record(crops.batch, &logged)?;
+        values.push(reset as f64);
+        if let Some((base_loss, kept)) = base {
+            values.extend([base_loss.into_scalar::<f32>() as f64, kept]);
+        }
+        run.record(crops.batch, &values)?;
 
         let done = run.state.step;
         if done % config.log_every == 0 || done == config.steps {
