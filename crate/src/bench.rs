@@ -180,7 +180,7 @@ fn train_vq_rate(config: &SpamConfig, steps: usize) -> f64 {
             &device,
         );
         let start = Instant::now();
-        let out = model.forward_train(x.clone(), None, &config.vq, &mut rng);
+        let out = model.forward_train(x.clone(), None, &config.vq, false, &mut rng);
         let loss = (out.reconstruction - x).abs().mean() + out.commitment * 0.02;
         let grads = GradientsParams::from_grads(loss.backward(), &model);
         model = optim.step(1e-4, model, grads);

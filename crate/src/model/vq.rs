@@ -52,6 +52,20 @@ pub struct VqConfig {
     /// Decay of the codebooks' exponential moving averages.
     #[config(default = 0.99)]
     pub ema_decay: f64,
+    /// A second encoder per part whose output joins the first's after layer 0: layer 0
+    /// quantizes the first encoder's output alone, the residual layers quantize the rest of
+    /// the sum. Added to a trained VQ-VAE (`MotionVq::with_detail_encoders`) with the first
+    /// encoders held, it lets the residual layers learn new detail while every layer-0 token,
+    /// the base transformer's vocabulary, stays exactly as it was. Absent (files written
+    /// before it existed) or false: none.
+    pub detail_encoders: Option<bool>,
+}
+
+impl VqConfig {
+    /// Whether the model has detail encoders (`detail_encoders`).
+    pub fn has_detail_encoders(&self) -> bool {
+        self.detail_encoders == Some(true)
+    }
 }
 
 /// A residual block: two convolutions around a ReLU, added to the input.
@@ -255,9 +269,15 @@ impl ResidualQuantizer {
         x.matmul(codebook.transpose()) * 2.0 - x_sq - c_sq
     }
 
-    /// Quantizes `z` (`[M, D]`) with the first `active` layers. Returns the summed code
-    /// vectors (no gradient), the codes per layer (`[M]` each) and what each layer saw.
-    pub fn quantize(&self, z: Tensor<2>, active: usize) -> (Tensor<2>, Vec<LayerAssignment>) {
+    /// Quantizes `z` (`[M, D]`) with the first `active` layers, `detail` (`[M, D]`, from
+    /// detail encoders) joining what layer 0 leaves. Returns the summed code vectors (no
+    /// gradient), the codes per layer (`[M]` each) and what each layer saw.
+    pub fn quantize(
+        &self,
+        z: Tensor<2>,
+        detail: Option<Tensor<2>>,
+        active: usize,
+    ) -> (Tensor<2>, Vec<LayerAssignment>) {
         let mut residual = z.detach();
         let mut total = residual.zeros_like();
         let mut layers = Vec::with_capacity(active);
@@ -270,6 +290,9 @@ impl ResidualQuantizer {
                 codes,
             });
             residual = residual - q.clone();
+            if let (0, Some(detail)) = (layer, &detail) {
+                residual = residual + detail.clone().detach();
+            }
             total = total + q;
         }
         (total, layers)
@@ -366,6 +389,8 @@ impl ResidualQuantizer {
 #[derive(Module, Debug)]
 pub struct MotionVq {
     encoders: Vec<PartEncoder>,
+    /// The detail encoders (`VqConfig::detail_encoders`), one per part.
+    detail: Option<Vec<PartEncoder>>,
     pub quantizers: Vec<ResidualQuantizer>,
     decoder: Decoder,
     /// Feature columns of each part, `[4]` index tensors kept as plain data.
@@ -402,6 +427,12 @@ impl VqConfig {
                 .iter()
                 .map(|c| PartEncoder::new(c.len(), self, device))
                 .collect(),
+            detail: self.has_detail_encoders().then(|| {
+                columns
+                    .iter()
+                    .map(|c| PartEncoder::new(c.len(), self, device))
+                    .collect()
+            }),
             quantizers: (0..4)
                 .map(|_| ResidualQuantizer::new(self, device))
                 .collect(),
@@ -419,18 +450,69 @@ impl MotionVq {
         self.layers
     }
 
-    /// Per part, the encoder output `[B, D, T/4]` for `x` `[B, T, 263]` (T a multiple of 4).
+    /// Per part, the encoder output `[B, D, T/4]` for `x` `[B, T, 263]` (T a multiple of 4):
+    /// what the quantizer's layers together approximate (with detail encoders, the sum of
+    /// both encoders' outputs).
     pub fn encode(&self, x: Tensor<3>) -> Vec<Tensor<3>> {
+        self.encode_split(x)
+            .into_iter()
+            .map(|(z, detail)| match detail {
+                Some(d) => z + d,
+                None => z,
+            })
+            .collect()
+    }
+
+    /// Per part, the first encoder's output (what layer 0 quantizes) and the detail
+    /// encoder's, if the model has them.
+    fn encode_split(&self, x: Tensor<3>) -> Vec<(Tensor<3>, Option<Tensor<3>>)> {
+        let base = self.encode_by(&self.encoders, x.clone());
+        let detail = match &self.detail {
+            Some(encoders) => self.encode_by(encoders, x).into_iter().map(Some).collect(),
+            None => vec![None; base.len()],
+        };
+        base.into_iter().zip(detail).collect()
+    }
+
+    /// Per part, `encoders`' output for that part's columns of `x`.
+    fn encode_by(&self, encoders: &[PartEncoder], x: Tensor<3>) -> Vec<Tensor<3>> {
         let device = x.device();
         self.columns
             .iter()
-            .zip(&self.encoders)
+            .zip(encoders)
             .map(|(cols, encoder)| {
                 let idx: Vec<i32> = cols.iter().map(|c| *c as i32).collect();
                 let idx = Tensor::<1, Int>::from_data(TensorData::new(idx, [cols.len()]), &device);
                 encoder.forward(x.clone().select(2, idx).swap_dims(1, 2))
             })
             .collect()
+    }
+
+    /// This VQ-VAE with detail encoders added, each a copy of its part's encoder whose
+    /// output convolution starts at zero: it reconstructs exactly as before until training
+    /// moves them, and starts from features that already describe the part.
+    pub fn with_detail_encoders(mut self) -> MotionVq {
+        /// New parameter ids for a copy: a clone shares its original's, and the optimizer
+        /// would then move the original with the copy's gradients.
+        struct FreshParams;
+        impl burn::module::ModuleMapper for FreshParams {
+            fn map_float<const D: usize>(&mut self, param: Param<Tensor<D>>) -> Param<Tensor<D>> {
+                Param::from_tensor(param.val().detach())
+            }
+        }
+        let copies = self
+            .encoders
+            .iter()
+            .map(|encoder| {
+                let mut copy = encoder.clone();
+                copy.output.weight = copy.output.weight.map(|w| w.zeros_like());
+                copy.output.bias = copy.output.bias.map(|b| b.map(|b| b.zeros_like()));
+                // After the zeroing, which leaves a constant: these are trainable.
+                copy.map(&mut FreshParams)
+            })
+            .collect();
+        self.detail = Some(copies);
+        self
     }
 
     /// `[B, D, N]` → `[B·N, D]` rows, time-major within each motion.
@@ -450,11 +532,14 @@ impl MotionVq {
     /// leading frames are its own (the rest pad a short clip by holding its last frame); the
     /// commitment and the codebook averages then count only tokens that start on a real
     /// frame, so padding's still poses do not pull the codes. `None`: every frame is real.
+    /// With `hold_base`, the first encoders run without gradients: they, and so every
+    /// layer-0 token, stay as they are (hold codebook 0 in `update_codebooks` too).
     pub fn forward_train(
         &self,
         x: Tensor<3>,
         real_frames: Option<&[usize]>,
         config: &VqConfig,
+        hold_base: bool,
         rng: &mut Rng,
     ) -> VqTrainOutput {
         let active = if (rng.uniform() as f64) < config.quantize_dropout {
@@ -485,11 +570,28 @@ impl MotionVq {
         let mut commitment: Option<Tensor<1>> = None;
         let mut assignments = Vec::with_capacity(4);
         let mut encodings = Vec::with_capacity(4);
-        for (z, quantizer) in self.encode(x).into_iter().zip(&self.quantizers) {
+        let encoded = if hold_base {
+            // As in `forward_decoder_train`: no graph for what no gradient reaches.
+            let frozen = self.valid();
+            let base = frozen.encode_by(&frozen.encoders, x.clone().without_autodiff());
+            let detail = match &self.detail {
+                Some(encoders) => self.encode_by(encoders, x).into_iter().map(Some).collect(),
+                None => vec![None; base.len()],
+            };
+            base.into_iter().map(|z| z.autodiff()).zip(detail).collect()
+        } else {
+            self.encode_split(x)
+        };
+        for ((z, detail), quantizer) in encoded.into_iter().zip(&self.quantizers) {
             let [b, _, n] = z.dims();
-            let rows = Self::rows(z);
-            encodings.push(rows.clone());
-            let (q, layers) = quantizer.quantize(rows.clone(), active);
+            let base = Self::rows(z);
+            let detail = detail.map(Self::rows);
+            encodings.push(base.clone());
+            let rows = match &detail {
+                Some(d) => base.clone() + d.clone(),
+                None => base.clone(),
+            };
+            let (q, layers) = quantizer.quantize(base, detail, active);
             let layers = layers
                 .into_iter()
                 .map(|a| LayerAssignment {
@@ -564,12 +666,12 @@ impl MotionVq {
         // through is never freed, and it filled 24 GiB in a few hundred steps.
         let frozen = self.valid();
         let parts: Vec<Tensor<3>> = frozen
-            .encode(x.without_autodiff())
+            .encode_split(x.without_autodiff())
             .into_iter()
             .zip(&frozen.quantizers)
-            .map(|(z, quantizer)| {
+            .map(|((z, detail), quantizer)| {
                 let [b, _, n] = z.dims();
-                let (q, _) = quantizer.quantize(Self::rows(z), layers);
+                let (q, _) = quantizer.quantize(Self::rows(z), detail.map(Self::rows), layers);
                 Self::unrows(q, b, n).autodiff()
             })
             .collect();
@@ -583,12 +685,13 @@ impl MotionVq {
 
     /// Tokens of `x` `[B, T, 263]` with every layer.
     pub fn tokenize(&self, x: Tensor<3>) -> PartTokens {
-        self.encode(x)
+        self.encode_split(x)
             .into_iter()
             .zip(&self.quantizers)
-            .map(|(z, quantizer)| {
+            .map(|((z, detail), quantizer)| {
                 let [b, _, n] = z.dims();
-                let (_, layers) = quantizer.quantize(Self::rows(z), self.layers);
+                let (_, layers) =
+                    quantizer.quantize(Self::rows(z), detail.map(Self::rows), self.layers);
                 layers
                     .into_iter()
                     .map(|a| a.codes.reshape([b, n]))
@@ -710,7 +813,7 @@ mod tests {
         let book = vq.quantizers[0].codebook(0);
         let picks = Tensor::<1, Int>::from_data(TensorData::new(vec![3i32, 17, 3], [3]), &device);
         let x = book.select(0, picks);
-        let (_, layers) = vq.quantizers[0].quantize(x, 1);
+        let (_, layers) = vq.quantizers[0].quantize(x, None, 1);
         let codes: Vec<i64> = layers[0].codes.clone().try_into_vec_as::<i64>().unwrap();
         assert_eq!(codes, vec![3, 17, 3]);
     }
@@ -728,7 +831,7 @@ mod tests {
         assert_eq!(plain.dims(), [2, 16, FEATURE_DIM]);
         // Decay 0 replaces every used code by the mean of what it quantized.
         let mut rng = Rng::new(3);
-        let out = vq.forward_train(x.clone(), None, &config, &mut rng);
+        let out = vq.forward_train(x.clone(), None, &config, false, &mut rng);
         vq.update_codebooks(&out.assignments, 0.0, 0, &mut rng);
         let gap = |a: Tensor<3>, b: Tensor<3>| (a - b).abs().max().into_scalar::<f32>();
         assert!(gap(vq.reconstruct_unquantized(x.clone()), plain) < 1e-6);
@@ -743,7 +846,7 @@ mod tests {
         let x = motion(2, 16, &device);
         let mut rng = Rng::new(5);
         // Motion 0 is whole; motion 1 has 5 real frames: tokens 0 and 1 start on real frames.
-        let out = vq.forward_train(x.clone(), Some(&[16, 5]), &config, &mut rng);
+        let out = vq.forward_train(x.clone(), Some(&[16, 5]), &config, false, &mut rng);
         for part in &out.assignments {
             assert_eq!(part.len(), 3);
             for layer in part {
@@ -754,7 +857,7 @@ mod tests {
         assert_eq!(out.reconstruction.dims(), [2, 16, FEATURE_DIM]);
         // Whole motions, said or not, quantize every token.
         for real in [None, Some(&[16, 16][..])] {
-            let out = vq.forward_train(x.clone(), real, &config, &mut rng);
+            let out = vq.forward_train(x.clone(), real, &config, false, &mut rng);
             assert_eq!(out.assignments[0][0].codes.dims(), [8]);
         }
     }
@@ -789,6 +892,7 @@ mod tests {
                 x.clone(),
                 None,
                 &config.clone().with_quantize_dropout(0.0),
+                false,
                 &mut rng,
             );
             let loss = (out.reconstruction - x.clone()).abs().mean() + out.commitment * 0.02;
@@ -886,7 +990,7 @@ mod tests {
         let (first0, first1, first_codes) = (books(&vq, 0), books(&vq, 1), layer0(&vq));
         let first_encoding = vq.encode(x.clone())[0].clone();
         for _ in 0..30 {
-            let out = vq.forward_train(x.clone(), None, &config, &mut rng);
+            let out = vq.forward_train(x.clone(), None, &config, false, &mut rng);
             let targets: Vec<Tensor<1, Int>> = anchor
                 .tokenize(x.clone().without_autodiff())
                 .into_iter()
@@ -917,5 +1021,41 @@ mod tests {
         );
         let kept = same.iter().filter(|s| **s).count() as f64 / now.len() as f64;
         assert!(kept >= 0.9, "layer-0 codes kept: {kept}");
+    }
+
+    #[test]
+    fn detail_encoders_start_as_the_model_and_learn_while_layer_0_stays() {
+        let device = Device::flex().autodiff();
+        let config = small().with_quantize_dropout(0.0);
+        let plain = config.init(&device);
+        let x = motion(2, 16, &device);
+        let layer0 = |vq: &MotionVq| -> Vec<i64> {
+            vq.tokenize(x.clone())
+                .iter()
+                .flat_map(|layers| layers[0].clone().try_into_vec_as::<i64>().unwrap())
+                .collect()
+        };
+        let gap = |a: Tensor<3>, b: Tensor<3>| (a - b).abs().max().into_scalar::<f32>();
+        let mut vq = plain.clone().with_detail_encoders();
+        assert!(gap(vq.reconstruct(x.clone()), plain.reconstruct(x.clone())) < 1e-6);
+        let first = layer0(&vq);
+        let mut optim = burn::optim::AdamConfig::new().init();
+        let mut rng = Rng::new(11);
+        let mut losses = Vec::new();
+        for _ in 0..30 {
+            let out = vq.forward_train(x.clone(), None, &config, true, &mut rng);
+            let loss = (out.reconstruction - x.clone()).abs().mean() + out.commitment * 0.02;
+            losses.push(loss.clone().into_scalar::<f32>());
+            let grads = burn::optim::GradientsParams::from_grads(loss.backward(), &vq);
+            vq = optim.step(3e-3, vq, grads);
+            vq.update_codebooks(&out.assignments, config.ema_decay, 1, &mut rng);
+        }
+        assert!(losses[29] < losses[0], "{losses:?}");
+        assert_eq!(layer0(&vq), first, "no layer-0 token moves");
+        let (base, whole) = (plain.encode(x.clone()), vq.encode(x.clone()));
+        assert!(
+            gap(base[0].clone(), whole[0].clone()) > 1e-3,
+            "the detail encoders learn"
+        );
     }
 }

@@ -87,6 +87,12 @@ pub struct VqTrainingConfig {
     /// layer 0 move.
     #[config(default = 0.0)]
     pub base_code_weight: f64,
+    /// Holds the first encoders and codebook 0 exactly as `--init` gave them, so every
+    /// layer-0 token stays; the residual codebooks, the decoder and (with the model's
+    /// `detail_encoders`, added to `--init`'s weights if they have none) the detail encoders
+    /// learn. Unlike `base_code_weight`, no token can move.
+    #[config(default = false)]
+    pub hold_base_codes: bool,
     #[config(default = 5.0)]
     pub checkpoint_minutes: f64,
     /// Steps between progress lines.
@@ -197,12 +203,20 @@ pub fn train_vq(
     ));
     // The turn column in radians of heading: stored normalised, as half the angle.
     let turn_scale = 2.0 * train.normalizer.std[ROOT_ROT_VEL.start] as f64;
-    let mut model = run.start_from(
-        config.model.init(device),
-        options.init.as_deref(),
-        resumed,
-        progress,
-    )?;
+    let mut model = match options.init.as_deref() {
+        // Detail encoders join weights that have none: copies of their first encoders.
+        Some(path) if config.model.has_detail_encoders() && !resumed => {
+            match run.start_from(config.model.init(device), Some(path), resumed, progress) {
+                Ok(model) => model,
+                Err(_) => {
+                    let plain = config.model.clone().with_detail_encoders(None);
+                    run.start_from(plain.init(device), Some(path), resumed, progress)?
+                        .with_detail_encoders()
+                }
+            }
+        }
+        init => run.start_from(config.model.init(device), init, resumed, progress)?,
+    };
     // The encoder whose layer-0 codes are held: `--init`'s, on every resumption too.
     let plain = device.clone().without_autodiff();
     let anchor = match (holds_base, options.init.as_deref()) {
@@ -252,7 +266,13 @@ pub fn train_vq(
                 encodings: Vec::new(),
             }
         } else {
-            model.forward_train(x.clone(), Some(&real_frames), &config.model, &mut rng)
+            model.forward_train(
+                x.clone(),
+                Some(&real_frames),
+                &config.model,
+                config.hold_base_codes,
+                &mut rng,
+            )
         };
         // Means over the motions' own frames: padding that holds a short clip's last frame
         // is not the clip.
@@ -327,7 +347,7 @@ pub fn train_vq(
             model.update_codebooks(
                 &out.assignments,
                 config.model.ema_decay,
-                holds_base as usize,
+                (holds_base || config.hold_base_codes) as usize,
                 &mut rng,
             )
         };

@@ -39,7 +39,8 @@ pub struct VqErrorArgs {
     #[arg(long)]
     codes: bool,
     /// Also print the share of layer-0 codes that these weights give the same as other
-    /// weights of the same sizes (e.g. the run a fine-tune started from).
+    /// weights of the same sizes, with or without detail encoders (e.g. the run a fine-tune
+    /// started from).
     #[arg(long)]
     base_codes_of: Option<PathBuf>,
 }
@@ -133,7 +134,11 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
         }
     }
     if let Some(path) = &args.base_codes_of {
-        let other = coma::weights::load_file(cfg.model.init(&device), path)?;
+        // The other weights may lack detail encoders (the run these were added to).
+        let other = coma::weights::load_file(cfg.model.init(&device), path).or_else(|_| {
+            let plain = cfg.model.clone().with_detail_encoders(None);
+            coma::weights::load_file(plain.init(&device), path)
+        })?;
         let share = coma::train::vq::base_code_agreement(&model, &other, &set, &device, args.limit);
         println!(
             "layer-0 codes the same as {}'s: {:.1} %",
