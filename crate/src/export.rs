@@ -353,7 +353,7 @@ pub fn export_prior(
 ) -> Result<ExportedPrior> {
     let device = Device::flex();
     let vq_config = <VqTrainingConfig as crate::train::ReadConfig>::read(&vq.join("config.json"))?;
-    let network = crate::weights::load_file(vq_config.model.init(&device), &vq.join("vq.bpk"))
+    let network = crate::weights::load_file(vq_config.init_model(&device), &vq.join("vq.bpk"))
         .context("cannot load the VQ-VAE")?;
     let spam_json = out.join("spam.json");
     let mut sizes = SpamConfig::load(&spam_json)

@@ -52,20 +52,6 @@ pub struct VqConfig {
     /// Decay of the codebooks' exponential moving averages.
     #[config(default = 0.99)]
     pub ema_decay: f64,
-    /// A second encoder per part whose output joins the first's after layer 0: layer 0
-    /// quantizes the first encoder's output alone, the residual layers quantize the rest of
-    /// the sum. Added to a trained VQ-VAE (`MotionVq::with_detail_encoders`) with the first
-    /// encoders held, it lets the residual layers learn new detail while every layer-0 token,
-    /// the base transformer's vocabulary, stays exactly as it was. Absent (files written
-    /// before it existed) or false: none.
-    pub detail_encoders: Option<bool>,
-}
-
-impl VqConfig {
-    /// Whether the model has detail encoders (`detail_encoders`).
-    pub fn has_detail_encoders(&self) -> bool {
-        self.detail_encoders == Some(true)
-    }
 }
 
 /// A residual block: two convolutions around a ReLU, added to the input.
@@ -389,7 +375,7 @@ impl ResidualQuantizer {
 #[derive(Module, Debug)]
 pub struct MotionVq {
     encoders: Vec<PartEncoder>,
-    /// The detail encoders (`VqConfig::detail_encoders`), one per part.
+    /// The detail encoders, one per part (see [`MotionVq::with_detail_encoders`]).
     detail: Option<Vec<PartEncoder>>,
     pub quantizers: Vec<ResidualQuantizer>,
     decoder: Decoder,
@@ -427,12 +413,7 @@ impl VqConfig {
                 .iter()
                 .map(|c| PartEncoder::new(c.len(), self, device))
                 .collect(),
-            detail: self.has_detail_encoders().then(|| {
-                columns
-                    .iter()
-                    .map(|c| PartEncoder::new(c.len(), self, device))
-                    .collect()
-            }),
+            detail: None,
             quantizers: (0..4)
                 .map(|_| ResidualQuantizer::new(self, device))
                 .collect(),
@@ -488,9 +469,13 @@ impl MotionVq {
             .collect()
     }
 
-    /// This VQ-VAE with detail encoders added, each a copy of its part's encoder whose
-    /// output convolution starts at zero: it reconstructs exactly as before until training
-    /// moves them, and starts from features that already describe the part.
+    /// This VQ-VAE with detail encoders added: a second encoder per part whose output joins
+    /// the first's after layer 0, so layer 0 quantizes the first encoder's output alone and
+    /// the residual layers the rest of the sum. Trained with the first encoders held, they
+    /// let the residual layers learn new detail while every layer-0 token, the base
+    /// transformer's vocabulary, stays exactly as it was. Each starts as a copy of its part's
+    /// encoder whose output convolution is zero: the VQ-VAE reconstructs exactly as before
+    /// until training moves them, from features that already describe the part.
     pub fn with_detail_encoders(mut self) -> MotionVq {
         /// New parameter ids for a copy: a clone shares its original's, and the optimizer
         /// would then move the original with the copy's gradients.

@@ -88,11 +88,15 @@ pub struct VqTrainingConfig {
     #[config(default = 0.0)]
     pub base_code_weight: f64,
     /// Holds the first encoders and codebook 0 exactly as `--init` gave them, so every
-    /// layer-0 token stays; the residual codebooks, the decoder and (with the model's
-    /// `detail_encoders`, added to `--init`'s weights if they have none) the detail encoders
-    /// learn. Unlike `base_code_weight`, no token can move.
+    /// layer-0 token stays; the residual codebooks, the decoder and (with `detail_encoders`)
+    /// the detail encoders learn. Unlike `base_code_weight`, no token can move.
     #[config(default = false)]
     pub hold_base_codes: bool,
+    /// The VQ-VAE has detail encoders ([`MotionVq::with_detail_encoders`]), added to
+    /// `--init`'s weights if they have none. A training setting rather than one of `model`'s
+    /// sizes: the page's models never have them, and its `spam.json` stays as it was.
+    #[config(default = false)]
+    pub detail_encoders: bool,
     #[config(default = 5.0)]
     pub checkpoint_minutes: f64,
     /// Steps between progress lines.
@@ -114,6 +118,19 @@ impl super::ReadConfig for VqTrainingConfig {
                 .with_context(|| format!("{} has no valid \"model\"", path.display()))?;
             Ok(VqTrainingConfig::new(model))
         })
+    }
+}
+
+impl VqTrainingConfig {
+    /// A VQ-VAE of this run's sizes with random weights (with detail encoders if the run has
+    /// them), for its weights to be loaded into.
+    pub fn init_model(&self, device: &Device) -> MotionVq {
+        let model = self.model.init(device);
+        if self.detail_encoders {
+            model.with_detail_encoders()
+        } else {
+            model
+        }
     }
 }
 
@@ -205,17 +222,15 @@ pub fn train_vq(
     let turn_scale = 2.0 * train.normalizer.std[ROOT_ROT_VEL.start] as f64;
     let mut model = match options.init.as_deref() {
         // Detail encoders join weights that have none: copies of their first encoders.
-        Some(path) if config.model.has_detail_encoders() && !resumed => {
-            match run.start_from(config.model.init(device), Some(path), resumed, progress) {
+        Some(path) if config.detail_encoders && !resumed => {
+            match run.start_from(config.init_model(device), Some(path), resumed, progress) {
                 Ok(model) => model,
-                Err(_) => {
-                    let plain = config.model.clone().with_detail_encoders(None);
-                    run.start_from(plain.init(device), Some(path), resumed, progress)?
-                        .with_detail_encoders()
-                }
+                Err(_) => run
+                    .start_from(config.model.init(device), Some(path), resumed, progress)?
+                    .with_detail_encoders(),
             }
         }
-        init => run.start_from(config.model.init(device), init, resumed, progress)?,
+        init => run.start_from(config.init_model(device), init, resumed, progress)?,
     };
     // The encoder whose layer-0 codes are held: `--init`'s, on every resumption too.
     let plain = device.clone().without_autodiff();

@@ -49,7 +49,7 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
     let split: coma::dataset::Split = args.split.parse().map_err(anyhow::Error::msg)?;
     let cfg = <coma::train::vq::VqTrainingConfig as coma::train::ReadConfig>::read(&args.config)?;
     let device = burn::tensor::Device::flex();
-    let model = coma::weights::load_file(cfg.model.init(&device), &args.weights)?;
+    let model = coma::weights::load_file(cfg.init_model(&device), &args.weights)?;
     let mut set = coma::dataset::motions::MotionSet::load(&args.data, split)?;
     if let Some(source) = &args.source {
         set = set.subset(|i| i.source.as_deref() == Some(source.as_str()));
@@ -135,10 +135,8 @@ pub fn run(args: VqErrorArgs) -> Result<()> {
     }
     if let Some(path) = &args.base_codes_of {
         // The other weights may lack detail encoders (the run these were added to).
-        let other = coma::weights::load_file(cfg.model.init(&device), path).or_else(|_| {
-            let plain = cfg.model.clone().with_detail_encoders(None);
-            coma::weights::load_file(plain.init(&device), path)
-        })?;
+        let other = coma::weights::load_file(cfg.init_model(&device), path)
+            .or_else(|_| coma::weights::load_file(cfg.model.init(&device), path))?;
         let share = coma::train::vq::base_code_agreement(&model, &other, &set, &device, args.limit);
         println!(
             "layer-0 codes the same as {}'s: {:.1} %",
