@@ -995,16 +995,9 @@ mod tests {
             .abs()
             .max();
         assert!(moved.into_scalar::<f32>() > 1e-3, "the encoder learns");
-        let (now, same): (Vec<i64>, Vec<bool>) = (
-            layer0(&vq).concat(),
-            layer0(&vq)
-                .concat()
-                .iter()
-                .zip(first_codes.concat())
-                .map(|(a, b)| *a == b)
-                .collect(),
-        );
-        let kept = same.iter().filter(|s| **s).count() as f64 / now.len() as f64;
+        let (now, first) = (layer0(&vq).concat(), first_codes.concat());
+        let same = now.iter().zip(&first).filter(|(a, b)| a == b).count();
+        let kept = same as f64 / now.len() as f64;
         assert!(kept >= 0.9, "layer-0 codes kept: {kept}");
     }
 
