@@ -162,12 +162,12 @@ pub fn export_spam(
     })
 }
 
-/// Bits of the VQ-VAE's parameter `name` when the model ships at `bits`: its encoders (detail
-/// encoders too) at 4 whatever `bits` says (generation, review and the page only decode; the
-/// encoders serve `coma edit` on an input motion and training), the rest at `bits`.
+/// Bits of the VQ-VAE's parameter `name` when the model ships at `bits`: its encoders at 4
+/// whatever `bits` says (generation, review and the page only decode; the encoders serve
+/// `coma edit` on an input motion and training), the rest at `bits`.
 fn vq_bits(name: &str, bits: Option<Bits>) -> Option<Bits> {
     bits.map(|b| {
-        if name.starts_with("encoders.") || name.starts_with("detail.") {
+        if name.starts_with("encoders.") {
             Bits::Four
         } else {
             b

@@ -236,11 +236,16 @@ impl ResidualQuantizer {
             .detach()
     }
 
-    /// Index of the nearest code of each row of `x` (`[M, D]` → `[M]`).
-    fn nearest(x: Tensor<2>, codebook: Tensor<2>) -> Tensor<1, Int> {
+    /// Squared distance of each row of `x` (`[M, D]`) to each code (`[M, K]`).
+    fn squared_distances(x: Tensor<2>, codebook: Tensor<2>) -> Tensor<2> {
         let x_sq = x.clone().powi_scalar(2).sum_dim(1); // [M, 1]
         let c_sq = codebook.clone().powi_scalar(2).sum_dim(1).transpose(); // [1, K]
-        let dist = x_sq - x.matmul(codebook.transpose()) * 2.0 + c_sq;
+        x_sq - x.matmul(codebook.transpose()) * 2.0 + c_sq
+    }
+
+    /// Index of the nearest code of each row of `x` (`[M, D]` → `[M]`).
+    fn nearest(x: Tensor<2>, codebook: Tensor<2>) -> Tensor<1, Int> {
+        let dist = Self::squared_distances(x, codebook);
         let [m, _] = dist.dims();
         dist.argmin(1).reshape([m])
     }
@@ -249,10 +254,7 @@ impl ResidualQuantizer {
     /// (`[M, K]`): logits whose argmax is the code the layer would choose, with a gradient
     /// to `x` (the codebook is held).
     pub fn code_logits(&self, x: Tensor<2>, layer: usize) -> Tensor<2> {
-        let codebook = self.codebook(layer);
-        let x_sq = x.clone().powi_scalar(2).sum_dim(1);
-        let c_sq = codebook.clone().powi_scalar(2).sum_dim(1).transpose();
-        x.matmul(codebook.transpose()) * 2.0 - x_sq - c_sq
+        Self::squared_distances(x, self.codebook(layer)).neg()
     }
 
     /// Quantizes `z` (`[M, D]`) with the first `active` layers, `detail` (`[M, D]`, from
@@ -435,7 +437,7 @@ impl MotionVq {
     /// what the quantizer's layers together approximate (with detail encoders, the sum of
     /// both encoders' outputs).
     pub fn encode(&self, x: Tensor<3>) -> Vec<Tensor<3>> {
-        self.encode_split(x)
+        self.encode_split(x, false)
             .into_iter()
             .map(|(z, detail)| match detail {
                 Some(d) => z + d,
@@ -445,9 +447,19 @@ impl MotionVq {
     }
 
     /// Per part, the first encoder's output (what layer 0 quantizes) and the detail
-    /// encoder's, if the model has them.
-    fn encode_split(&self, x: Tensor<3>) -> Vec<(Tensor<3>, Option<Tensor<3>>)> {
-        let base = self.encode_by(&self.encoders, x.clone());
+    /// encoder's, if the model has them. With `hold_base` the first encoders run without
+    /// gradients.
+    fn encode_split(&self, x: Tensor<3>, hold_base: bool) -> Vec<(Tensor<3>, Option<Tensor<3>>)> {
+        let base = if hold_base {
+            // As in `forward_decoder_train`: no graph for what no gradient reaches.
+            let frozen: Vec<PartEncoder> = self.encoders.iter().map(|e| e.valid()).collect();
+            self.encode_by(&frozen, x.clone().without_autodiff())
+                .into_iter()
+                .map(|z| z.autodiff())
+                .collect()
+        } else {
+            self.encode_by(&self.encoders, x.clone())
+        };
         let detail = match &self.detail {
             Some(encoders) => self.encode_by(encoders, x).into_iter().map(Some).collect(),
             None => vec![None; base.len()],
@@ -555,18 +567,7 @@ impl MotionVq {
         let mut commitment: Option<Tensor<1>> = None;
         let mut assignments = Vec::with_capacity(4);
         let mut encodings = Vec::with_capacity(4);
-        let encoded = if hold_base {
-            // As in `forward_decoder_train`: no graph for what no gradient reaches.
-            let frozen = self.valid();
-            let base = frozen.encode_by(&frozen.encoders, x.clone().without_autodiff());
-            let detail = match &self.detail {
-                Some(encoders) => self.encode_by(encoders, x).into_iter().map(Some).collect(),
-                None => vec![None; base.len()],
-            };
-            base.into_iter().map(|z| z.autodiff()).zip(detail).collect()
-        } else {
-            self.encode_split(x)
-        };
+        let encoded = self.encode_split(x, hold_base);
         for ((z, detail), quantizer) in encoded.into_iter().zip(&self.quantizers) {
             let [b, _, n] = z.dims();
             let base = Self::rows(z);
@@ -651,7 +652,7 @@ impl MotionVq {
         // through is never freed, and it filled 24 GiB in a few hundred steps.
         let frozen = self.valid();
         let parts: Vec<Tensor<3>> = frozen
-            .encode_split(x.without_autodiff())
+            .encode_split(x.without_autodiff(), false)
             .into_iter()
             .zip(&frozen.quantizers)
             .map(|((z, detail), quantizer)| {
@@ -670,7 +671,7 @@ impl MotionVq {
 
     /// Tokens of `x` `[B, T, 263]` with every layer.
     pub fn tokenize(&self, x: Tensor<3>) -> PartTokens {
-        self.encode_split(x)
+        self.encode_split(x, false)
             .into_iter()
             .zip(&self.quantizers)
             .map(|((z, detail), quantizer)| {
