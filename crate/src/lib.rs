@@ -38,7 +38,9 @@ pub mod executor;
 #[cfg(feature = "native")]
 pub mod export;
 pub mod features;
+pub mod feet;
 pub mod geom;
+pub mod limb;
 pub mod mocap;
 pub mod model;
 pub mod motion_file;

@@ -16,8 +16,18 @@
 //! the test applies the same fix to them: the fix is a function of the joints alone, so equal
 //! fixed joints still prove the link decodes to the motion it was made with (and re-recording
 //! would have the fixtures prove only that the engine agrees with itself today).
+//!
+//! Since issue 37 the engine also plants the feet of every motion ([`coma::feet`]), which
+//! needs the decoded features (their contact channels), not the joints alone. So the test
+//! holds the recording against the motion as decoded and put on the reference skeleton, and
+//! then checks that the engine's answer is exactly that motion with its feet planted
+//! ([`coma::session::finish`]'s two steps): the link still opens to the motion it was made
+//! with, as the engine now shows it.
 
+use coma::agents::pipeline;
 use coma::executor::block_on;
+use coma::features::{features_to_joints, with_reference_bones};
+use coma::feet::plant_feet;
 use coma::session::{Command, Llm, Outcome, Session};
 use coma::share::{self, LinkPlan};
 use coma::skeleton::{self, Pose};
@@ -78,18 +88,32 @@ fn links_of_both_versions_open_to_the_motion_they_were_made_with() {
         };
         assert!(notes.is_empty(), "{notes:?}");
         let recorded = recorded_joints(name);
-        assert_eq!(motion.joints.len(), recorded.len(), "{name}");
-        let worst = motion
+        let decoded = match link.plan.plan() {
+            Some(plan) => {
+                block_on(pipeline::motion_features(
+                    session.model(),
+                    plan,
+                    &link.tokens,
+                ))
+                .0
+            }
+            None => block_on(session.model().features(&link.tokens)),
+        };
+        let decoded = with_reference_bones(&decoded);
+        let before_planting: Vec<Pose> = features_to_joints(&decoded);
+        assert_eq!(before_planting.len(), recorded.len(), "{name}");
+        let worst = skeleton::max_joint_distance(&before_planting, &recorded);
+        assert!(worst < 2e-5, "{name}: joints differ by up to {worst} m");
+        let planted: Vec<Pose> = features_to_joints(&plant_feet(&decoded));
+        let shown: Vec<Pose> = motion
             .joints
             .iter()
-            .zip(&recorded)
-            .flat_map(|(a, b)| {
-                a.iter()
-                    .flatten()
-                    .zip(b.iter().flatten())
-                    .map(|(x, y)| (f64::from(*x) - y).abs())
-            })
-            .fold(0f64, f64::max);
-        assert!(worst < 2e-5, "{name}: joints differ by up to {worst} m");
+            .map(|p| p.map(|j| j.map(f64::from)))
+            .collect();
+        let off = skeleton::max_joint_distance(&shown, &planted);
+        assert!(
+            off < 1e-5,
+            "{name}: the engine's joints are {off} m from the planted motion"
+        );
     }
 }

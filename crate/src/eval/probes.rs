@@ -367,6 +367,30 @@ pub fn pelvis_rise(poses: &[Pose]) -> f64 {
     }
 }
 
+/// Rise of the pelvis above its starting height (metres) beyond which a frame is part of a
+/// jump: a walk bobs it by a few centimetres, a jump lifts it by 0.2 m or more.
+pub const JUMP_RISE_M: f64 = 0.1;
+
+/// Horizontal distance the pelvis covers per jump, metres: from the first frame to the last,
+/// divided by the jumps (stretches of frames with the pelvis more than [`JUMP_RISE_M`] above
+/// its starting height; at least one). A standing two-footed jump forward covers about a
+/// metre in the training clips.
+pub fn travel_per_jump(poses: &[Pose]) -> f64 {
+    let (Some(first), Some(last)) = (poses.first(), poses.last()) else {
+        return 0.0;
+    };
+    let start = start_height(poses);
+    let up: Vec<bool> = poses
+        .iter()
+        .map(|p| p[joint::PELVIS][1] - start > JUMP_RISE_M)
+        .collect();
+    let jumps = (0..up.len())
+        .filter(|&t| up[t] && (t == 0 || !up[t - 1]))
+        .count();
+    let (a, b) = (first[joint::PELVIS], last[joint::PELVIS]);
+    (a[0] - b[0]).hypot(a[2] - b[2]) / jumps.max(1) as f64
+}
+
 /// How much lower the pelvis is over the last half second than at the start, metres: lying
 /// down ends with it near the floor, about 0.8 m below standing.
 pub fn pelvis_lowered_at_end(poses: &[Pose]) -> f64 {
@@ -425,6 +449,17 @@ pub const JUMP: ActionProbe = ActionProbe {
     measure: pelvis_rise,
 };
 
+/// "A person jumps forward", by the [`travel_per_jump`] (m): the 90th percentile of the
+/// training clips bounds it from above as the 10th does from below.
+pub const JUMP_TRAVEL: ActionProbe = ActionProbe {
+    name: "jump-travel",
+    prompt: "a person jumps forward",
+    contents: &["jump", "jump-forward"],
+    measure_name: "travel per jump",
+    unit: " m",
+    measure: travel_per_jump,
+};
+
 /// "A person lies down on the floor", by the [`pelvis_lowered_at_end`] (m).
 pub const LIE_DOWN: ActionProbe = ActionProbe {
     name: "lie-down",
@@ -456,7 +491,16 @@ pub const THROW: ActionProbe = ActionProbe {
 };
 
 /// Every action probe.
-pub const ACTIONS: [&ActionProbe; 7] = [&BOW, &LEFT_WAVE, &SQUAT, &JUMP, &LIE_DOWN, &KICK, &THROW];
+pub const ACTIONS: [&ActionProbe; 8] = [
+    &BOW,
+    &LEFT_WAVE,
+    &SQUAT,
+    &JUMP,
+    &JUMP_TRAVEL,
+    &LIE_DOWN,
+    &KICK,
+    &THROW,
+];
 
 /// The probe's measure of each motion of `set` that shows its action.
 pub fn real_performances(set: &MotionSet, probe: &ActionProbe) -> Vec<f64> {
@@ -513,7 +557,9 @@ pub fn action(
                         let tokens = model
                             .generate_with(probe.prompt, &[], frames, &options)
                             .await;
-                        (probe.measure)(&model.joints(&tokens).await)
+                        // Measured as the engine shows it (feet planted).
+                        let shown = crate::session::finish(&model.features(&tokens).await);
+                        (probe.measure)(&crate::features::features_to_joints(&shown))
                     })
                 })
                 .collect();

@@ -15,8 +15,10 @@ use crate::model::generate::SamplingOptions;
 use crate::model::transformer::TEXT_DIM;
 use crate::model::Spam;
 use crate::plan::{PartEdits, Plan, PlannerKind, Segment};
+use crate::posture::measure::{floating_share, floor_penetration};
 use crate::rng::Rng;
-use crate::session::{Command, Llm, Outcome, Session};
+use crate::session::{finish, Command, Llm, Outcome, Session};
+use crate::skeleton::Pose;
 use crate::timing::FPS;
 use anyhow::Result;
 use burn::prelude::*;
@@ -71,6 +73,11 @@ pub struct Row {
     pub multimodality: Option<Interval>,
     /// Share of frames with a skating foot (see [`super::probes::foot_skating`]).
     pub foot_skating: Interval,
+    /// Share of frames in which the body floats (no joint near the floor, longer than a
+    /// jump's flight; see [`crate::posture::measure::floating_share`]).
+    pub floating: Interval,
+    /// Deepest any joint of any motion went under the floor (y = 0), metres.
+    pub floor_penetration: f64,
     /// Repetitions the row was measured on.
     pub repeats: usize,
     /// Top-3 R-precision of the captions of each motion capture source's test motions
@@ -96,6 +103,8 @@ struct Figures {
     diversity: Vec<f64>,
     multimodality: Vec<f64>,
     skating: Vec<f64>,
+    floating: Vec<f64>,
+    floor_penetration: f64,
     /// Per source: captions whose own motion ranked in the top 3, and captions counted.
     by_source: BTreeMap<String, (usize, usize)>,
 }
@@ -113,6 +122,8 @@ impl Figures {
             multimodality: (!self.multimodality.is_empty())
                 .then(|| Interval::of(&self.multimodality)),
             foot_skating: Interval::of(&self.skating),
+            floating: Interval::of(&self.floating),
+            floor_penetration: self.floor_penetration,
             repeats: self.top.len(),
             top3_by_source: self
                 .by_source
@@ -198,7 +209,7 @@ fn reviewed(
         let Ok(Outcome::Run(run)) = outcome else {
             unreachable!("a run of a valid plan answers with its motion: {outcome:?}")
         };
-        session.model().spam.decode(&run.motion.tokens).await
+        session.model().normalizer.normalize(&run.motion.features)
     })
 }
 
@@ -312,7 +323,10 @@ impl Protocol<'_> {
                                 };
                                 let text = part_text(sentence, &[]);
                                 let tokens = spam.generate(&text, frames.min(196), &options).await;
-                                spam.decode(&tokens).await
+                                // Measured as the engine shows it (feet planted).
+                                let normalizer = &self.test.normalizer;
+                                let decoded = normalizer.denormalize(&spam.decode(&tokens).await);
+                                normalizer.normalize(&finish(&decoded))
                             })
                         };
                         let length = |k: usize| self.test.items[order[k]].features.len();
@@ -361,14 +375,19 @@ impl Protocol<'_> {
                     }
                 }
                 let motions = self.embed(&features);
-                let skating: f64 = features
+                let joints: Vec<Vec<Pose>> = features
                     .iter()
-                    .map(|f| {
-                        foot_skating(&features_to_joints(&self.test.normalizer.denormalize(f)))
-                    })
-                    .sum::<f64>()
-                    / features.len() as f64;
-                fig.skating.push(skating);
+                    .map(|f| features_to_joints(&self.test.normalizer.denormalize(f)))
+                    .collect();
+                let mean = |measure: fn(&[Pose]) -> f64| {
+                    joints.iter().map(|j| measure(j)).sum::<f64>() / joints.len() as f64
+                };
+                fig.skating.push(mean(foot_skating));
+                fig.floating.push(mean(floating_share));
+                fig.floor_penetration = joints
+                    .iter()
+                    .map(|j| floor_penetration(j))
+                    .fold(fig.floor_penetration, f64::max);
                 if matches!(source, Source::Retrieval) {
                     // The same caption always retrieves the same motion.
                     fig.multimodality.push(0.0);

@@ -26,6 +26,9 @@ pub struct ActionReference {
     /// 10th percentile of their measures: a generated motion that reaches it performs the
     /// action about as much as the dataset does.
     pub p10: f64,
+    /// 90th percentile of their measures: a generated motion far beyond it overdoes the action
+    /// (a jump that flies three metres).
+    pub p90: f64,
     /// Median length of those motions, seconds, on generation's 0.2 s grid (1 to 9.8 s): how
     /// long a generated performance is asked to be. A kick takes under 2 s and lying down
     /// about 6; a fixed length would ask for a kick held or a lying down cut short.
@@ -59,6 +62,7 @@ impl ActionReference {
         (!real.is_empty()).then(|| ActionReference {
             motions: real.len(),
             p10: quantile(real.clone(), 0.1),
+            p90: quantile(real.clone(), 0.9),
             median: quantile(real, 0.5),
             seconds: ((quantile(frames, 0.5) / FPS * step).round() / step).clamp(1.0, 9.8),
         })

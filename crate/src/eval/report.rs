@@ -205,7 +205,7 @@ impl EvalReport {
         }
         for a in &p.actions {
             md.push_str(&format!(
-                "| \"{}\" ({} s, {} seeds): {} median (training motions' 10th percentile, median) | {:.2}{u} ({:.2}{u}, {:.2}{u}); {:.0} % of seeds reach the 10th percentile |\n",
+                "| \"{}\" ({} s, {} seeds): {} median (training motions' 10th percentile, median, 90th percentile) | {:.2}{u} ({:.2}{u}, {:.2}{u}, {:.2}{u}); {:.0} % of seeds reach the 10th percentile |\n",
                 a.prompt,
                 a.seconds,
                 a.seeds,
@@ -213,6 +213,7 @@ impl EvalReport {
                 a.median,
                 a.real.p10,
                 a.real.median,
+                a.real.p90,
                 a.reaching * 100.0,
                 u = a.unit,
             ));
@@ -222,6 +223,22 @@ impl EvalReport {
                 md.push_str(&format!(
                     "| foot skating ratio: {name} | {} |\n",
                     row.foot_skating
+                ));
+            }
+        }
+        for name in ROW_ORDER {
+            if let Some(row) = self.rows.get(name) {
+                md.push_str(&format!(
+                    "| floating frames (no joint within 5 cm of the floor, longer than a 0.8 s jump): {name} | {} |\n",
+                    row.floating
+                ));
+            }
+        }
+        for name in ROW_ORDER {
+            if let Some(row) = self.rows.get(name) {
+                md.push_str(&format!(
+                    "| deepest joint under the floor, any frame: {name} | {:.3} m |\n",
+                    row.floor_penetration
                 ));
             }
         }
@@ -249,6 +266,8 @@ mod tests {
             diversity: i,
             multimodality: None,
             foot_skating: i,
+            floating: i,
+            floor_penetration: 0.0,
             repeats,
             top3_by_source: BTreeMap::new(),
         }
@@ -305,6 +324,7 @@ mod tests {
                     motions: 40,
                     median: 0.42,
                     p10: 0.3,
+                    p90: 0.5,
                     seconds: 1.6,
                 },
                 median: 0.35,
@@ -319,7 +339,7 @@ mod tests {
         assert!(md.contains("| left/right: asked ankle rises higher | 95.0 % |"));
         assert!(md.contains("| &nbsp;&nbsp;\"a person kicks with the left foot\" | 19/20 |"));
         assert!(
-            md.contains("| \"a person does a squat\" (4 s, 20 seeds): pelvis drop median (training motions' 10th percentile, median) | 0.35 m (0.30 m, 0.42 m); 70 % of seeds reach the 10th percentile |"),
+            md.contains("| \"a person does a squat\" (4 s, 20 seeds): pelvis drop median (training motions' 10th percentile, median, 90th percentile) | 0.35 m (0.30 m, 0.42 m, 0.50 m); 70 % of seeds reach the 10th percentile |"),
             "{md}"
         );
         assert!(report.json().contains("\"reaching\": 0.7"));

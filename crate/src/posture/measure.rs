@@ -94,6 +94,31 @@ pub fn in_flight(poses: &[Pose]) -> Vec<bool> {
         .collect()
 }
 
+/// Longest airborne stretch (frames at 20 fps) that is a jump rather than a body floating:
+/// 0.8 s in the air is a rise of the centre of mass of about 0.8 m, beyond any standing jump.
+pub const MAX_FLIGHT_FRAMES: usize = 16;
+
+/// Share of frames in which the body floats: no joint within [`FLIGHT_CLEARANCE_M`] of the
+/// floor (y = 0) in a stretch longer than [`MAX_FLIGHT_FRAMES`], so not the flight of a jump.
+pub fn floating_share(poses: &[Pose]) -> f64 {
+    let airborne = in_flight(poses);
+    let (mut floating, mut run) = (0, 0);
+    for (t, &up) in airborne.iter().enumerate() {
+        run = if up { run + 1 } else { 0 };
+        // The last frame of an airborne stretch decides what the stretch was.
+        if up && airborne.get(t + 1) != Some(&true) && run > MAX_FLIGHT_FRAMES {
+            floating += run;
+        }
+    }
+    floating as f64 / poses.len().max(1) as f64
+}
+
+/// How deep the lowest joint goes under the floor (y = 0) over the motion, metres; 0 when no
+/// joint goes under it.
+pub fn floor_penetration(poses: &[Pose]) -> f64 {
+    (-lowest_joint(poses)).max(0.0)
+}
+
 /// Per frame pair `(i, i + 1)`, whether its speeds count against the bar: neither frame is in
 /// flight or next to a frame in flight.
 pub fn counted_pairs(poses: &[Pose]) -> Vec<bool> {
@@ -321,6 +346,22 @@ mod tests {
         let s = joint_speeds(&[a, b]);
         assert_eq!(s.len(), 22);
         assert!((s[3] - 1.0).abs() < 1e-9 && s.iter().filter(|&&v| v > 0.0).count() == 1);
+    }
+
+    #[test]
+    fn a_jump_flies_and_a_hovering_body_floats() {
+        let standing = [[0.0, 0.0, 0.0]; crate::skeleton::NUM_JOINTS];
+        let lifted = |h: f64| standing.map(|p| [p[0], p[1] + h, p[2]]);
+        // 10 frames on the floor, a 10-frame jump, 10 on the floor, 20 frames hovering.
+        let mut poses = vec![standing; 10];
+        poses.extend(vec![lifted(0.3); 10]);
+        poses.extend(vec![standing; 10]);
+        poses.extend(vec![lifted(0.1); 20]);
+        assert!((floating_share(&poses) - 20.0 / 50.0).abs() < 1e-12);
+        assert_eq!(floating_share(&poses[..30]), 0.0);
+        assert_eq!(floor_penetration(&poses), 0.0);
+        poses[3][joint::L_FOOT][1] = -0.02;
+        assert!((floor_penetration(&poses) - 0.02).abs() < 1e-12);
     }
 
     #[test]

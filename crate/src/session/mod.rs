@@ -25,7 +25,8 @@ use crate::agents::llm::Transport;
 use crate::agents::pipeline::{self, RunOptions};
 use crate::agents::reviewer::Scorer;
 use crate::dataset::Vocabulary;
-use crate::features::{features_to_joints, with_reference_bones};
+use crate::features::{features_to_joints, with_reference_bones, FeatureFrame, Features};
+use crate::feet::plant_feet;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
 use crate::model::motion_model::sampling;
 use crate::model::tokens::MotionTokens;
@@ -309,7 +310,8 @@ impl Session {
     /// Every motion the engine answers with is made here, and here it gets the one skeleton
     /// ([`with_reference_bones`]): the model predicts each joint on its own, so its bones
     /// stretch; fixed once in the features, the joints shown, the BVH, the JSON and both NPY
-    /// exports all describe the same motion on the same bones.
+    /// exports all describe the same motion on the same bones. Here too its feet are planted
+    /// ([`plant_feet`]), whatever made it.
     async fn motion(&self, tokens: MotionTokens, plan: Option<&Plan>) -> (Motion, Vec<String>) {
         let (features, notes) = match plan {
             Some(plan) => pipeline::motion_features(&self.model, plan, &tokens).await,
@@ -327,6 +329,8 @@ impl Session {
             }
             _ => (features, notes),
         };
+        // Feet planted last, on whatever was laid, so every motion leaves with them.
+        let features = plant_feet(&features);
         let joints = features_to_joints(&features)
             .iter()
             .map(|p| p.map(|j| j.map(|v| v as f32)))
@@ -338,6 +342,13 @@ impl Session {
         };
         (motion, notes)
     }
+}
+
+/// Decoded features (not normalised) as the engine hands them out when no plan lays paths or
+/// key postures on them: on the reference skeleton, feet planted. The evaluation measures
+/// SPAM's motions through it, so it measures what a user sees.
+pub fn finish(features: &[FeatureFrame]) -> Features {
+    plant_feet(&with_reference_bones(features))
 }
 
 /// The training vocabulary from its file.

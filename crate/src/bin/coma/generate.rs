@@ -23,6 +23,10 @@ pub struct GenerateArgs {
     /// Filmstrip PNG to write.
     #[arg(long)]
     png: Option<PathBuf>,
+    /// Folder for a before/after look at the feet: filmstrips of the motion as decoded and as
+    /// the engine hands it out (feet planted), side view, and its figures printed.
+    #[arg(long)]
+    compare_feet: Option<PathBuf>,
     /// Classifier-free guidance scale of the base transformer: 1 follows the learnt
     /// conditional distribution, more follows the text harder (default 4).
     #[arg(long)]
@@ -42,6 +46,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         guidance: args.guidance,
     };
     let motion = execute_motion(&session, command)?;
+    if let Some(dir) = &args.compare_feet {
+        compare_feet(&session, &motion, dir, &args.prompt)?;
+    }
     write_outputs(
         &motion.features,
         args.out.as_deref(),
@@ -61,4 +68,38 @@ fn parse_parts(parts: &[String]) -> Result<Vec<(coma::skeleton::BodyPart, String
             Ok((part, instruction.trim().to_string()))
         })
         .collect()
+}
+
+/// Writes `before.png` and `after.png` into `dir`: the motion as SPAM decoded it (on the
+/// reference skeleton) and as the engine returned it; prints both motions' foot figures.
+fn compare_feet(
+    session: &coma::session::Session,
+    motion: &coma::session::Motion,
+    dir: &std::path::Path,
+    prompt: &str,
+) -> Result<()> {
+    use coma::features::{features_to_joints, with_reference_bones};
+    use coma::posture::measure::{floating_share, floor_penetration, foot_skating};
+    use coma::render::{write_filmstrip, FilmstripOptions, View};
+    let decoded = coma::executor::block_on(session.model().features(&motion.tokens));
+    let before = features_to_joints(&with_reference_bones(&decoded));
+    let after = features_to_joints(&motion.features);
+    std::fs::create_dir_all(dir)?;
+    for (name, poses) in [("before", &before), ("after", &after)] {
+        println!(
+            "{name}: foot skating {:.3}, floating frames {:.3}, deepest under the floor {:.3} m",
+            foot_skating(poses),
+            floating_share(poses),
+            floor_penetration(poses)
+        );
+        let options = FilmstripOptions {
+            frames: 12,
+            columns: 6,
+            cell_size: 200,
+            title: Some(format!("{prompt}: {name} planting the feet")),
+            view: View::Side,
+        };
+        write_filmstrip(&dir.join(format!("{name}.png")), poses, &options)?;
+    }
+    Ok(())
 }

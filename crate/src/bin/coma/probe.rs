@@ -74,6 +74,9 @@ enum ProbeCommand {
     Squat(ActionArgs),
     /// "A person jumps with both feet": how high the pelvis rises, against the dataset's jumps.
     Jump(ActionArgs),
+    /// "A person jumps forward": how far the pelvis travels per jump, against the dataset's
+    /// jumps (their 90th percentile bounds it from above).
+    JumpTravel(ActionArgs),
     /// "A person lies down on the floor": how much lower the pelvis ends, against the
     /// dataset's lying down.
     LieDown(ActionArgs),
@@ -103,6 +106,7 @@ pub fn run(args: ProbeArgs) -> Result<()> {
         | ProbeCommand::Wave(ActionArgs { model, .. })
         | ProbeCommand::Squat(ActionArgs { model, .. })
         | ProbeCommand::Jump(ActionArgs { model, .. })
+        | ProbeCommand::JumpTravel(ActionArgs { model, .. })
         | ProbeCommand::LieDown(ActionArgs { model, .. })
         | ProbeCommand::Kick(ActionArgs { model, .. })
         | ProbeCommand::Throw(ActionArgs { model, .. })
@@ -142,6 +146,9 @@ pub fn run(args: ProbeArgs) -> Result<()> {
         ProbeCommand::Wave(args) => action_probe(&generator, &coma::eval::probes::LEFT_WAVE, args)?,
         ProbeCommand::Squat(args) => action_probe(&generator, &coma::eval::probes::SQUAT, args)?,
         ProbeCommand::Jump(args) => action_probe(&generator, &coma::eval::probes::JUMP, args)?,
+        ProbeCommand::JumpTravel(args) => {
+            action_probe(&generator, &coma::eval::probes::JUMP_TRAVEL, args)?
+        }
         ProbeCommand::LieDown(args) => {
             action_probe(&generator, &coma::eval::probes::LIE_DOWN, args)?
         }
@@ -175,10 +182,11 @@ fn action_probe(generator: &MotionModel, probe: &ActionProbe, args: ActionArgs) 
     let (name, unit) = (probe.measure_name, probe.unit);
     let p10 = real.p10;
     println!(
-        "real {} ({} training motions): {name} median {:.2}{unit}, 10th percentile {p10:.2}{unit}",
+        "real {} ({} training motions): {name} median {:.2}{unit}, 10th percentile {p10:.2}{unit}, 90th percentile {:.2}{unit}",
         probe.contents.join("/"),
         real.motions,
-        real.median
+        real.median,
+        real.p90
     );
     let options = coma::model::generate::SamplingOptions {
         top_k: args.top_k,

@@ -1,0 +1,535 @@
+//! Planted feet: the clean-up every motion gets before the engine hands it out (generated,
+//! edited, blended or built from key postures), so feet that carry weight stay where they are
+//! put and nothing sinks into the floor.
+//!
+//! The motion model predicts each joint on its own, so a foot that should rest on the floor
+//! drifts a few centimetres a frame (SPAM's foot skating was 0.203 against 0.056 for real
+//! motions, `EVAL.md`). [`plant_feet`], on features that are not normalised:
+//! 1. finds the contacts of each foot joint (ankle, toe): frames where the joint is near its
+//!    lowest height and either the model's contact channel says so or it barely moves;
+//! 2. pins each contact span where the joint is on average over the span, and eases the pin in
+//!    and out over [`BLEND_FRAMES`] (two spans of one joint close together hand the offset
+//!    from one to the other), so feet never jump;
+//! 3. puts the lowest pinned contact on the floor (y = 0) and keeps every foot joint above it;
+//! 4. bends each leg onto its targets by two-bone IK from the hip ([`crate::limb::two_bone`]),
+//!    which keeps every bone's length; the pelvis and the upper body do not move;
+//! 5. lifts a frame whose other joints (knees, hands, a lying body) would be under the floor;
+//! 6. writes the features again: root height, root-relative positions and velocities from the
+//!    new joints, and the legs' 6D rotations turned by as much as their bones turned.
+//!
+//! It is deterministic (the same features give the same joints, bit for bit, natively and in
+//! the page), so a share link, which carries tokens, rebuilds the same cleaned motion.
+
+use crate::features::{
+    features_to_joints_with_final, recover_root, FeatureFrame, Features, CONTACTS, POSITIONS,
+    ROOT_HEIGHT, ROTATIONS, VELOCITIES,
+};
+use crate::geom::{self, Quat, Vec3};
+use crate::limb::two_bone;
+use crate::skeleton::{inverse_kinematics, joint, Pose, Rotations};
+use crate::timing::FPS;
+
+/// Height above a foot joint's lowest point in the motion (metres) under which it can be in
+/// contact with the floor.
+pub const CONTACT_BAND_M: f64 = 0.06;
+/// Horizontal speed (m/s) under which a low foot joint counts as planted even where the
+/// model's contact channel says it is lifted.
+pub const PLANT_SPEED: f64 = 0.6;
+/// A foot joint whose lowest point stays this far above the motion's lowest foot point
+/// (metres) never touches the floor (a leg held up) and is never pinned.
+pub const NEVER_DOWN_M: f64 = 0.15;
+/// A pin that would move its joint further than this (metres) from where the model put it is
+/// not a drifting foot but a moving one (a shuffle): it is left as it is.
+pub const MAX_PIN_OFFSET_M: f64 = 0.2;
+/// Frames (20 fps) over which a pin eases in before its span and out after it.
+pub const BLEND_FRAMES: usize = 4;
+
+/// The four foot joints in the features' contact order: left ankle, left toe, right ankle,
+/// right toe.
+const FEET: [usize; 4] = [joint::L_ANKLE, joint::L_FOOT, joint::R_ANKLE, joint::R_FOOT];
+
+/// A leg: hip, knee, ankle, toe.
+struct Leg {
+    joints: [usize; 4],
+    /// Indices into [`FEET`] of its ankle and toe.
+    feet: [usize; 2],
+}
+
+const LEGS: [Leg; 2] = [
+    Leg {
+        joints: [joint::L_HIP, joint::L_KNEE, joint::L_ANKLE, joint::L_FOOT],
+        feet: [0, 1],
+    },
+    Leg {
+        joints: [joint::R_HIP, joint::R_KNEE, joint::R_ANKLE, joint::R_FOOT],
+        feet: [2, 3],
+    },
+];
+
+/// A run of contact frames of one foot joint, inclusive, and where it is pinned.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Span {
+    start: usize,
+    end: usize,
+    pin: Vec3,
+}
+
+/// Per frame, whether each of the four foot joints ([`FEET`] order) is in contact with the
+/// floor: near its lowest height and either marked so by the model's contact channel or
+/// moving slower than [`PLANT_SPEED`]. `poses` has one pose more than `features` has rows
+/// (the last row's velocities lead to it); that pose takes the last row's channel.
+fn contacts(features: &[FeatureFrame], poses: &[Pose]) -> Vec<[bool; 4]> {
+    let n = poses.len();
+    let lowest: [f64; 4] =
+        FEET.map(|j| poses.iter().map(|p| p[j][1]).fold(f64::INFINITY, f64::min));
+    let ground = lowest.iter().copied().fold(f64::INFINITY, f64::min);
+    (0..n)
+        .map(|t| {
+            let row = &features[t.min(features.len() - 1)];
+            std::array::from_fn(|k| {
+                let j = FEET[k];
+                let (a, b) = (poses[t.saturating_sub(1)][j], poses[(t + 1).min(n - 1)][j]);
+                let frames = ((t + 1).min(n - 1) - t.saturating_sub(1)).max(1) as f64;
+                let speed = (a[0] - b[0]).hypot(a[2] - b[2]) / frames * FPS;
+                let low = poses[t][j][1] - lowest[k] < CONTACT_BAND_M;
+                let marked = row[CONTACTS.start + k] > 0.5;
+                lowest[k] - ground < NEVER_DOWN_M && low && (marked || speed < PLANT_SPEED)
+            })
+        })
+        .collect()
+}
+
+/// The contact spans of one foot joint: runs of contact frames (a one-frame gap is closed),
+/// each pinned where the joint is on average over it, horizontally, at its median height.
+/// Spans whose pin would move the joint more than [`MAX_PIN_OFFSET_M`] are left out.
+fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
+    let mut on = contact.to_vec();
+    for t in 1..on.len().saturating_sub(1) {
+        if !on[t] && on[t - 1] && on[t + 1] {
+            on[t] = true;
+        }
+    }
+    let mut out = Vec::new();
+    let mut t = 0;
+    while t < on.len() {
+        if !on[t] {
+            t += 1;
+            continue;
+        }
+        let start = t;
+        while t + 1 < on.len() && on[t + 1] {
+            t += 1;
+        }
+        let end = t;
+        t += 1;
+        let frames = &positions[start..=end];
+        let count = frames.len() as f64;
+        let mut heights: Vec<f64> = frames.iter().map(|p| p[1]).collect();
+        heights.sort_by(f64::total_cmp);
+        let pin = [
+            frames.iter().map(|p| p[0]).sum::<f64>() / count,
+            heights[heights.len() / 2],
+            frames.iter().map(|p| p[2]).sum::<f64>() / count,
+        ];
+        let far = frames
+            .iter()
+            .any(|p| geom::dist(*p, pin) > MAX_PIN_OFFSET_M);
+        if !far {
+            out.push(Span { start, end, pin });
+        }
+    }
+    out
+}
+
+/// Per frame, the pin's weight (0–1) and the offset that would put the joint on its pin
+/// (metres): inside a span the full offset; between two spans the offset of one handed to the
+/// other's with an eased blend; the weight eases from 1 to 0 over [`BLEND_FRAMES`] on either
+/// side of a span.
+fn pin_offsets(spans: &[Span], positions: &[Vec3]) -> Vec<(f64, Vec3)> {
+    let offset = |t: usize, s: &Span| geom::sub(s.pin, positions[t]);
+    let reach = (BLEND_FRAMES + 1) as f64;
+    let fade = |gap: usize| geom::ease(1.0 - gap as f64 / reach);
+    (0..positions.len())
+        .map(|t| {
+            let before = spans.iter().rev().find(|s| s.start <= t);
+            let after = spans.iter().find(|s| s.end >= t);
+            match (before, after) {
+                (Some(b), _) if t <= b.end => (1.0, offset(t, b)),
+                (Some(b), Some(a)) => {
+                    let (d0, d1) = (offset(b.end, b), offset(a.start, a));
+                    let u = (t - b.end) as f64 / (a.start - b.end) as f64;
+                    let weight = fade(t - b.end).max(fade(a.start - t));
+                    (weight, geom::lerp(d0, d1, geom::ease(u)))
+                }
+                (Some(b), None) => (fade(t - b.end), offset(b.end, b)),
+                (None, Some(a)) => (fade(a.start - t), offset(a.start, a)),
+                (None, None) => (0.0, [0.0; 3]),
+            }
+        })
+        .collect()
+}
+
+/// The 6D rotation of a feature row's joint `j` (1–21) as a rotation.
+fn rotation_6d(row: &FeatureFrame, j: usize) -> Quat {
+    let c = ROTATIONS.start + (j - 1) * 6;
+    let v = |k: usize| row[c + k] as f64;
+    let b1 = geom::normalize([v(0), v(1), v(2)]);
+    let a2 = [v(3), v(4), v(5)];
+    let b2 = geom::normalize(geom::sub(a2, geom::scale(b1, geom::dot(b1, a2))));
+    Quat::from_columns(b1, b2, geom::cross(b1, b2))
+}
+
+fn write_rotation_6d(row: &mut FeatureFrame, j: usize, q: Quat) {
+    let m = q.to_matrix();
+    let six = [m[0][0], m[1][0], m[2][0], m[0][1], m[1][1], m[2][1]];
+    let c = ROTATIONS.start + (j - 1) * 6;
+    row[c..c + 6].copy_from_slice(&six.map(|v| v as f32));
+}
+
+/// Bends `leg` of `pose` so its ankle and toe reach `targets` as near as the bones allow,
+/// keeping the hip where it is and every bone's length.
+fn bend_leg(pose: &mut Pose, leg: &Leg, [ankle_target, toe_target]: [Vec3; 2]) {
+    let [hip, knee, ankle, toe] = leg.joints;
+    let lengths = [
+        geom::dist(pose[hip], pose[knee]),
+        geom::dist(pose[knee], pose[ankle]),
+    ];
+    let foot = geom::sub(pose[toe], pose[ankle]);
+    let foot_length = geom::norm(foot);
+    // A straight leg bends its knee over the toes.
+    let hint = geom::normalize([foot[0], 0.0, foot[2]]);
+    let (new_knee, new_ankle) = two_bone(
+        [pose[hip], pose[knee], pose[ankle]],
+        ankle_target,
+        lengths,
+        hint,
+        0.0,
+    );
+    let aim = geom::sub(toe_target, new_ankle);
+    let aim = if geom::norm(aim) > 1e-9 { aim } else { foot };
+    pose[knee] = new_knee;
+    pose[ankle] = new_ankle;
+    pose[toe] = geom::add(new_ankle, geom::scale(geom::normalize(aim), foot_length));
+}
+
+/// The same motion with planted feet (see the module's doc): features that are not
+/// normalised in, as many rows out. Motions of fewer than 2 rows come back unchanged.
+pub fn plant_feet(features: &[FeatureFrame]) -> Features {
+    if features.len() < 2 {
+        return features.to_vec();
+    }
+    let original = features_to_joints_with_final(features);
+    if original.iter().flatten().flatten().any(|v| !v.is_finite()) {
+        return features.to_vec();
+    }
+    let contact = contacts(features, &original);
+    let spans: Vec<Vec<Span>> = (0..FEET.len())
+        .map(|k| {
+            let on: Vec<bool> = contact.iter().map(|c| c[k]).collect();
+            let at: Vec<Vec3> = original.iter().map(|p| p[FEET[k]]).collect();
+            spans(&on, &at)
+        })
+        .collect();
+
+    // The lowest pinned contact goes on the floor; without any, the lowest joint does.
+    let floor = spans
+        .iter()
+        .flatten()
+        .map(|s| s.pin[1])
+        .reduce(f64::min)
+        .unwrap_or_else(|| crate::skeleton::lowest_joint(&original));
+    let mut poses: Vec<Pose> = original
+        .iter()
+        .map(|p| p.map(|v| [v[0], v[1] - floor, v[2]]))
+        .collect();
+    let offsets: Vec<Vec<(f64, Vec3)>> = (0..FEET.len())
+        .map(|k| {
+            let at: Vec<Vec3> = poses.iter().map(|p| p[FEET[k]]).collect();
+            let lowered: Vec<Span> = spans[k]
+                .iter()
+                .map(|s| Span {
+                    pin: [s.pin[0], s.pin[1] - floor, s.pin[2]],
+                    ..*s
+                })
+                .collect();
+            pin_offsets(&lowered, &at)
+        })
+        .collect();
+
+    for (t, pose) in poses.iter_mut().enumerate() {
+        for leg in &LEGS {
+            let [a, b] = leg.feet;
+            let ((wa, da), (wb, db)) = (offsets[a][t], offsets[b][t]);
+            let (oa, ob) = (geom::scale(da, wa), geom::scale(db, wb));
+            // An unpinned ankle follows its pinned toe (a heel rising off a planted toe), and
+            // the other way round, so the foot keeps its shape.
+            let move_a = geom::add(oa, geom::scale(ob, 1.0 - wa));
+            let move_b = geom::add(ob, geom::scale(oa, 1.0 - wb));
+            let [_, _, ankle, toe] = leg.joints;
+            let mut targets = [geom::add(pose[ankle], move_a), geom::add(pose[toe], move_b)];
+            for target in &mut targets {
+                target[1] = target[1].max(0.0);
+            }
+            if geom::dist(targets[0], pose[ankle]) > 1e-9
+                || geom::dist(targets[1], pose[toe]) > 1e-9
+            {
+                bend_leg(pose, leg, targets);
+            }
+        }
+    }
+
+    // What still goes under the floor (knees, hands, a lying body) lifts its frame, eased
+    // over the neighbouring frames so the lift is not a jump.
+    let sunk: Vec<f64> = poses
+        .iter()
+        .map(|p| (-p.iter().map(|v| v[1]).fold(f64::INFINITY, f64::min)).max(0.0))
+        .collect();
+    if sunk.iter().any(|&s| s > 0.0) {
+        let reach = (BLEND_FRAMES + 1) as f64;
+        let lifts: Vec<f64> = (0..poses.len())
+            .map(|t| {
+                let lo = t.saturating_sub(BLEND_FRAMES);
+                let hi = (t + BLEND_FRAMES).min(poses.len() - 1);
+                (lo..=hi)
+                    .map(|u| sunk[u] * geom::ease(1.0 - t.abs_diff(u) as f64 / reach))
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        for (pose, lift) in poses.iter_mut().zip(lifts) {
+            for v in pose.iter_mut() {
+                v[1] += lift;
+            }
+        }
+    }
+    rewrite(features, &original, &poses)
+}
+
+/// `features` rewritten to describe `poses` (one more than the rows), whose pelvis differs
+/// from `original`'s only in height and whose legs may have turned.
+fn rewrite(features: &[FeatureFrame], original: &[Pose], poses: &[Pose]) -> Features {
+    let (facing, _) = recover_root(features);
+    let before: Vec<Rotations> = inverse_kinematics(original, true);
+    let after: Vec<Rotations> = inverse_kinematics(poses, true);
+    let legs = [
+        joint::L_HIP,
+        joint::R_HIP,
+        joint::L_KNEE,
+        joint::R_KNEE,
+        joint::L_ANKLE,
+        joint::R_ANKLE,
+        joint::L_FOOT,
+        joint::R_FOOT,
+    ];
+    features
+        .iter()
+        .enumerate()
+        .map(|(t, row)| {
+            let mut out = *row;
+            let (pose, next, facing) = (&poses[t], &poses[t + 1], facing[t]);
+            let root = pose[0];
+            out[ROOT_HEIGHT.start] = root[1] as f32;
+            for (j, p) in pose.iter().enumerate().skip(1) {
+                let local = [p[0] - root[0], p[1], p[2] - root[2]];
+                let c = POSITIONS.start + (j - 1) * 3;
+                out[c..c + 3].copy_from_slice(&facing.rotate(local).map(|v| v as f32));
+            }
+            for (j, (now, then)) in pose.iter().zip(next).enumerate() {
+                let v = facing.rotate(geom::sub(*then, *now));
+                let c = VELOCITIES.start + j * 3;
+                out[c..c + 3].copy_from_slice(&v.map(|v| v as f32));
+            }
+            // Relative to the pelvis: a frame only lifted keeps its rotations.
+            let moved = legs.iter().any(|&j| {
+                let now = geom::sub(pose[j], pose[0]);
+                geom::dist(now, geom::sub(original[t][j], original[t][0])) > 1e-9
+            });
+            if moved {
+                for &j in &legs {
+                    let turn = after[t][j].mul(before[t][j].inv());
+                    let turned = turn.mul(rotation_6d(row, j)).normalized();
+                    write_rotation_6d(&mut out, j, turned);
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::{features_to_joints, joints_to_features};
+    use crate::posture::measure::foot_skating;
+    use crate::skeleton::{forward_kinematics, max_bone_deviation, Offsets, PARENTS};
+
+    /// A person standing still, 30 frames, then the given change per frame.
+    fn standing(frames: usize) -> Vec<Pose> {
+        let offsets = Offsets::reference();
+        let rest = forward_kinematics(&[[Quat::IDENTITY; 22]], &offsets, &[[0.0, 0.0, 0.0]])[0];
+        // Pelvis at the height that puts the lowest joint on the floor.
+        let low = rest.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+        let rest = rest.map(|p| [p[0], p[1] - low, p[2]]);
+        vec![rest; frames]
+    }
+
+    /// Features of `poses` as the dataset would compute them.
+    fn features_of(poses: &[Pose]) -> Features {
+        joints_to_features(poses, &Offsets::from_pose(&poses[0]))
+            .unwrap()
+            .0
+    }
+
+    /// A standing person whose left foot slides 21.6 cm sideways along the floor at 0.54 m/s
+    /// (frames 10–18), as a drifting generated foot does.
+    fn sliding_left_foot() -> Features {
+        let mut poses = standing(40);
+        for (t, pose) in poses.iter_mut().enumerate() {
+            let shift = [0.027 * t.clamp(10, 18).saturating_sub(10) as f64, 0.0, 0.0];
+            let leg = &LEGS[0];
+            let [_, _, ankle, toe] = leg.joints;
+            let targets = [geom::add(pose[ankle], shift), geom::add(pose[toe], shift)];
+            bend_leg(pose, leg, targets);
+        }
+        features_of(&poses)
+    }
+
+    fn bone_lengths(pose: &Pose) -> Vec<f64> {
+        (1..22)
+            .map(|j| geom::dist(pose[j], pose[PARENTS[j].unwrap()]))
+            .collect()
+    }
+
+    #[test]
+    fn a_sliding_planted_foot_stays_put_and_the_bones_keep_their_lengths() {
+        let features = sliding_left_foot();
+        let before = features_to_joints(&features);
+        let skating_before = foot_skating(&before);
+        let cleaned = plant_feet(&features);
+        assert_eq!(cleaned.len(), features.len());
+        let after = features_to_joints(&cleaned);
+        assert!(
+            skating_before > 0.15,
+            "the test motion skates: {skating_before}"
+        );
+        assert_eq!(foot_skating(&after), 0.0);
+        let drift = geom::dist(
+            after[0][joint::L_FOOT],
+            after[after.len() - 1][joint::L_FOOT],
+        );
+        let moved = geom::dist(
+            before[0][joint::L_FOOT],
+            before[before.len() - 1][joint::L_FOOT],
+        );
+        assert!(
+            moved > 0.2 && drift < 0.01,
+            "toe drift {drift} m (was {moved} m)"
+        );
+        let reference = bone_lengths(&before[0]);
+        for pose in &after {
+            for (a, b) in bone_lengths(pose).iter().zip(&reference) {
+                assert!((a - b).abs() < 1e-4, "bone {a} vs {b}");
+            }
+        }
+        assert!(max_bone_deviation(&after) < 1e-4);
+        // The pelvis, the upper body and the other leg do not move, but for the one lift that
+        // puts the lowest contact on the floor.
+        let lift = after[0][0][1] - before[0][0][1];
+        assert!(lift.abs() < 0.02, "lifted {lift} m");
+        for (a, b) in after.iter().zip(&before) {
+            for j in [0, 3, 6, 9, 12, 15, 20, 21, joint::R_KNEE, joint::R_FOOT] {
+                let b = [b[j][0], b[j][1] + lift, b[j][2]];
+                assert!(geom::dist(a[j], b) < 1e-5, "joint {j} moved");
+            }
+        }
+    }
+
+    #[test]
+    fn the_lowest_contact_is_on_the_floor_and_nothing_is_under_it() {
+        // The whole motion 7 cm too high, and one frame's knee pushed under the floor.
+        let mut features = sliding_left_foot();
+        for row in &mut features {
+            row[ROOT_HEIGHT.start] += 0.07;
+            for j in 1..22 {
+                row[POSITIONS.start + (j - 1) * 3 + 1] += 0.07;
+            }
+        }
+        let cleaned = plant_feet(&features);
+        let poses = features_to_joints(&cleaned);
+        let lowest = crate::skeleton::lowest_joint(&poses);
+        // Within a millimetre: a toe reaches its pin only as far as the foot's length allows.
+        assert!(lowest.abs() < 1e-3, "lowest joint at {lowest} m");
+        let mut sunk = features.clone();
+        let knee = POSITIONS.start + (joint::L_KNEE - 1) * 3 + 1;
+        sunk[10][knee] = -0.05;
+        let poses = features_to_joints(&plant_feet(&sunk));
+        assert!(crate::skeleton::lowest_joint(&poses) > -1e-5);
+    }
+
+    #[test]
+    fn feet_in_the_air_are_not_pulled_down() {
+        // Stands, jumps 30 cm for 8 frames, lands.
+        let mut poses = standing(40);
+        for (t, pose) in poses.iter_mut().enumerate() {
+            let up = if (15..23).contains(&t) { 0.3 } else { 0.0 };
+            for p in pose.iter_mut() {
+                p[1] += up;
+            }
+        }
+        let features = features_of(&poses);
+        let after = features_to_joints(&plant_feet(&features));
+        let before = features_to_joints(&features);
+        for t in 15..23 {
+            let (a, b) = (after[t][joint::L_FOOT][1], before[t][joint::L_FOOT][1]);
+            assert!((a - b).abs() < 1e-5, "frame {t}: toe at {a} m, was {b} m");
+        }
+    }
+
+    #[test]
+    fn cleaning_is_deterministic_and_a_clean_motion_stays_nearly_as_it_is() {
+        let features = sliding_left_foot();
+        let once = plant_feet(&features);
+        assert_eq!(once, plant_feet(&features));
+        let twice = plant_feet(&once);
+        let (a, b) = (features_to_joints(&once), features_to_joints(&twice));
+        assert!(crate::skeleton::max_joint_distance(&a, &b) < 0.01);
+        let still = features_of(&standing(30));
+        let kept = plant_feet(&still);
+        let moved = crate::skeleton::max_joint_distance(
+            &features_to_joints(&still),
+            &features_to_joints(&kept),
+        );
+        assert!(moved < 1e-5, "a still pose moved {moved} m");
+    }
+
+    #[test]
+    fn odd_input_comes_back_unchanged() {
+        assert!(plant_feet(&[]).is_empty());
+        let one = [[0.0f32; 263]];
+        assert_eq!(plant_feet(&one), one.to_vec());
+        let mut bad = sliding_left_foot();
+        bad[3][ROOT_HEIGHT.start] = f32::NAN;
+        let out = plant_feet(&bad);
+        assert_eq!(out.len(), bad.len());
+        assert!(out[3][ROOT_HEIGHT.start].is_nan());
+    }
+
+    #[test]
+    fn turned_leg_rotations_still_describe_the_legs() {
+        // The rewritten 6D rotations of the sliding leg match the rotations computed from the
+        // cleaned joints as the dataset would, within the model-to-IK gap of the input.
+        let features = sliding_left_foot();
+        let cleaned = plant_feet(&features);
+        let ik = inverse_kinematics(
+            &crate::features::features_to_joints_with_final(&cleaned),
+            true,
+        );
+        for (t, row) in cleaned.iter().enumerate() {
+            for j in [joint::L_HIP, joint::L_KNEE] {
+                let q = rotation_6d(row, j);
+                let d = q.mul(ik[t][j].inv()).normalized();
+                let angle = 2.0 * d.0[0].abs().min(1.0).acos();
+                assert!(angle < 0.05, "frame {t} joint {j}: {angle} rad off");
+            }
+        }
+    }
+}
