@@ -2,7 +2,7 @@
 // WebDriver BiDi by puppeteer-core. It loads the page, generates a motion with no LLM (the
 // built-in planner; Firefox has no WebGPU adapter here, so the model runs on the CPU backend),
 // copies the share link and opens it in a fresh browser context, which must rebuild the same
-// joints. Console errors and uncaught errors of the pages and their workers fail it.
+// joints. Console errors and warnings and uncaught errors of the pages and their workers fail it.
 //
 // Needs: the built page in DIST (default ../dist), the coma binary in COMA (serves the page),
 // Firefox in FIREFOX (default /usr/bin/firefox-esr). Never downloads a browser.
@@ -85,21 +85,39 @@ async function open(context, url) {
   const outside = [];
   const log = [];
   const keep = (line) => { log.push(line); if (log.length > 200) log.shift(); };
+  // Warnings count too: the page warns only when something stopped working (the guidance
+  // partner worker, for one), and Firefox itself says nothing on this page today. Firefox
+  // reports the workers' console lines as the page's (with the worker listener kept for
+  // browsers that report them on the worker).
+  const bad = (type) => type === "error" || type === "warn" || type === "warning";
   page.on("console", (m) => {
     keep(`${m.type()}: ${m.text()}`);
-    if (m.type() === "error") problems.push(`console: ${m.text()}`);
+    if (bad(m.type())) problems.push(`console ${m.type()}: ${m.text()}`);
   });
-  page.on("pageerror", (e) => { keep(`uncaught: ${e.message}`); problems.push(`uncaught: ${e.message}`); });
+  // An uncaught error (Firefox reports the workers' as the page's) ends any wait at once.
+  let crash;
+  const crashed = new Promise((_, reject) => { crash = reject; });
+  crashed.catch(() => {});
+  page.on("pageerror", (e) => {
+    keep(`uncaught: ${e.message}`);
+    problems.push(`uncaught: ${e.message}`);
+    crash(new Error(`uncaught error: ${e.message}`));
+  });
   page.on("workercreated", (w) => {
     keep(`worker started: ${w.url()}`);
     w.on("console", (m) => {
       keep(`worker ${m.type()}: ${m.text()}`);
-      if (m.type() === "error") problems.push(`worker console: ${m.text()}`);
+      if (bad(m.type())) problems.push(`worker console ${m.type()}: ${m.text()}`);
     });
   });
-  page.on("request", (req) => { if (!req.url().startsWith(BASE)) outside.push(req.url()); });
+  // data: URLs load nothing from anywhere (Firefox reports the page's `data:,` icon and fonts
+  // decoded from data: URLs as requests; Chromium does not), so only network schemes count.
+  page.on("request", (req) => {
+    const url = req.url();
+    if (!url.startsWith(BASE) && !url.startsWith("data:")) outside.push(url);
+  });
   await page.goto(url);
-  return { page, problems, outside, log };
+  return { page, problems, outside, log, crashed };
 }
 
 /** What the page shows, for failure messages: its status, joints hash and console. */
@@ -113,12 +131,14 @@ async function describe(opened) {
   return `the page shows ${JSON.stringify(seen)}\nconsole:\n${opened.log.slice(-40).join("\n")}`;
 }
 
-/** Waits until `check` (run in the page with `arg`) holds; on a timeout the error says what
- * the page shows and what its console said. Polls on an interval: a tab in the background
+/** Waits until `check` (run in the page with `arg`) holds; on a timeout or an uncaught error
+ * the error says what the page shows and what its console said. Polls on an interval: a tab in the background
  * gets no animation frames. */
 async function until(opened, what, check, arg) {
+  const waiting = opened.page.waitForFunction(check, { timeout: LOAD_TIMEOUT, polling: 200 }, arg);
+  waiting.catch(() => {});
   try {
-    await opened.page.waitForFunction(check, { timeout: LOAD_TIMEOUT, polling: 200 }, arg);
+    await Promise.race([waiting, opened.crashed]);
   } catch (e) {
     throw new Error(`waiting for ${what}: ${e.message}\n${await describe(opened)}`);
   }
@@ -187,11 +207,13 @@ test("in Firefox, the page generates a motion and its share link rebuilds the sa
     // The link in a fresh browser context (nothing shared with the first tab) rebuilds it.
     const other = await browser.createBrowserContext();
     const second = await open(other, link);
-    await until(second, `the shared motion (joints ${hash})`, (h) => document.querySelector(".viewer")?.dataset.jointsHash === h
-      && !document.querySelector("#generate").disabled, hash);
+    await until(second, "the shared motion", () => !!document.querySelector(".viewer")?.dataset.jointsHash
+      && !document.querySelector("#generate").disabled);
+    const rebuilt = await second.page.$eval(".viewer", (v) => v.dataset.jointsHash);
+    assert.equal(rebuilt, hash, `the share link rebuilt other joints\n${await describe(second)}`);
 
     for (const p of [first, second]) {
-      assert.deepEqual(p.problems, [], `errors in Firefox's console\n${await describe(p)}`);
+      assert.deepEqual(p.problems, [], `errors or warnings in Firefox's console\n${await describe(p)}`);
       assert.deepEqual(p.outside, [], "the page sent something out");
       const error = await p.page.$eval("#status", (e) => e.classList.contains("error"));
       assert.ok(!error, `the page shows an error\n${await describe(p)}`);
