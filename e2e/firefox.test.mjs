@@ -170,7 +170,7 @@ test("in Firefox, the page generates a motion and its share link rebuilds the sa
     await until(first, "the model to load", idle);
     const status = await page.$eval("#status", (e) => e.textContent);
     const modelLine = await page.$eval("#model-line", (e) => e.textContent).catch(() => "");
-    console.log(`loaded in ${((Date.now() - loadStarted) / 1000).toFixed(1)} s: ${status} (${modelLine})`);
+    console.log(`loaded in ${((Date.now() - loadStarted) / 1000).toFixed(1)} s: ${modelLine || status}`);
     assert.match(status, /loaded .* on (WebGPU|the CPU)/, await describe(first));
 
     // A 196-frame walk, no review round, typed as a user would.
