@@ -110,8 +110,8 @@ async function open(context, url) {
       if (bad(m.type())) problems.push(`worker console ${m.type()}: ${m.text()}`);
     });
   });
-  // data: URLs load nothing from anywhere (Firefox reports the page's `data:,` icon and fonts
-  // decoded from data: URLs as requests; Chromium does not), so only network schemes count.
+  // data: URLs load nothing from anywhere (Firefox reports the page's `data:,` icon and a font
+  // it decodes from a data: URL as requests; Chromium does not), so they are not "out".
   page.on("request", (req) => {
     const url = req.url();
     if (!url.startsWith(BASE) && !url.startsWith("data:")) outside.push(url);
@@ -132,8 +132,8 @@ async function describe(opened) {
 }
 
 /** Waits until `check` (run in the page with `arg`) holds; on a timeout or an uncaught error
- * the error says what the page shows and what its console said. Polls on an interval: a tab in the background
- * gets no animation frames. */
+ * the error says what the page shows and what its console said. Polls on an interval: a tab
+ * in the background gets no animation frames. */
 async function until(opened, what, check, arg) {
   const waiting = opened.page.waitForFunction(check, { timeout: LOAD_TIMEOUT, polling: 200 }, arg);
   waiting.catch(() => {});
