@@ -49,3 +49,6 @@ coma_bin="$(realpath "$target_dir/release/coma")"
 shots="$(realpath -m "$target_dir/e2e-screenshots")"
 mkdir -p "$shots"
 (cd e2e && COMA="$coma_bin" DIST=../dist SHOTS="$shots" node --test --test-concurrency=1 page.test.mjs)
+
+echo "== the page in headless Firefox ESR (the core test: load, generate, the share link rebuilds it)"
+(cd e2e && COMA="$coma_bin" DIST=../dist node --test --test-concurrency=1 firefox.test.mjs)

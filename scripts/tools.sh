@@ -19,14 +19,18 @@ ensure_wasm_test_runner() {
   fi
 }
 
-# Debian's Chromium and its driver, and Playwright's driver library (no browser download):
-# what the browser tests need.
+# Debian's Chromium and its driver, Debian's Firefox ESR, Playwright's driver library and
+# puppeteer-core (no browser download): what the browser tests need.
 ensure_browser_tools() {
-  if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
-    echo "installing chromium and chromium-driver (once)"
-    apt-get update -q && apt-get install -y -q chromium chromium-driver
+  local missing=()
+  command -v chromium >/dev/null || missing+=(chromium)
+  command -v chromedriver >/dev/null || missing+=(chromium-driver)
+  command -v firefox-esr >/dev/null || missing+=(firefox-esr)
+  if [ "${#missing[@]}" -gt 0 ]; then
+    echo "installing ${missing[*]} (once)"
+    apt-get update -q && apt-get install -y -q "${missing[@]}"
   fi
-  if [ ! -d e2e/node_modules/playwright-core ]; then
+  if [ ! -d e2e/node_modules/playwright-core ] || [ ! -d e2e/node_modules/puppeteer-core ]; then
     (cd e2e && npm install --no-audit --no-fund)
   fi
 }
