@@ -11,6 +11,8 @@
 //!    and out over [`BLEND_FRAMES`] (two spans of one joint close together hand the offset
 //!    from one to the other), so feet never jump;
 //! 3. puts the lowest pinned contact on the floor (y = 0) and keeps every foot joint above it;
+//!    a foot that moves along the floor out of contact (a swing that skims the ground) is
+//!    raised to clear it by [`SWING_CLEARANCE_M`];
 //! 4. bends each leg onto its targets by two-bone IK from the hip ([`crate::limb::two_bone`]),
 //!    which keeps every bone's length; the pelvis and the upper body do not move;
 //! 5. lifts a frame whose other joints (knees, hands, a lying body) would be under the floor;
@@ -38,9 +40,14 @@ pub const PLANT_SPEED: f64 = 0.6;
 /// A foot joint whose lowest point stays this far above the motion's lowest foot point
 /// (metres) never touches the floor (a leg held up) and is never pinned.
 pub const NEVER_DOWN_M: f64 = 0.15;
-/// A pin that would move its joint further than this (metres) from where the model put it is
-/// not a drifting foot but a moving one (a shuffle): it is left as it is.
-pub const MAX_PIN_OFFSET_M: f64 = 0.2;
+/// Farthest (metres) a foot joint in contact may travel along the floor and still be one
+/// stance; a longer slide is cut into stances with steps between them.
+pub const STEP_M: f64 = 0.25;
+/// Frames (20 fps) a foot takes to step from one stance to the next where a slide is cut.
+pub const STEP_GAP_FRAMES: usize = 2;
+/// Height (metres) above its resting height that a moving foot joint out of contact is
+/// raised to: the skating measure counts a foot within 5 cm of the floor as on it.
+pub const SWING_CLEARANCE_M: f64 = 0.06;
 /// Frames (20 fps) over which a pin eases in before its span and out after it.
 pub const BLEND_FRAMES: usize = 4;
 
@@ -76,32 +83,105 @@ struct Span {
 
 /// Per frame, whether each of the four foot joints ([`FEET`] order) is in contact with the
 /// floor: near its lowest height and either marked so by the model's contact channel or
-/// moving slower than [`PLANT_SPEED`]. `poses` has one pose more than `features` has rows
+/// moving slower than [`PLANT_SPEED`]; where no joint is, the low joints of the lower foot. `poses` has one pose more than `features` has rows
 /// (the last row's velocities lead to it); that pose takes the last row's channel.
 fn contacts(features: &[FeatureFrame], poses: &[Pose]) -> Vec<[bool; 4]> {
-    let n = poses.len();
-    let lowest: [f64; 4] =
-        FEET.map(|j| poses.iter().map(|p| p[j][1]).fold(f64::INFINITY, f64::min));
-    let ground = lowest.iter().copied().fold(f64::INFINITY, f64::min);
-    (0..n)
+    let (lowest, down) = lowest_points(poses);
+    (0..poses.len())
         .map(|t| {
             let row = &features[t.min(features.len() - 1)];
-            std::array::from_fn(|k| {
-                let j = FEET[k];
-                let (a, b) = (poses[t.saturating_sub(1)][j], poses[(t + 1).min(n - 1)][j]);
-                let frames = ((t + 1).min(n - 1) - t.saturating_sub(1)).max(1) as f64;
-                let speed = (a[0] - b[0]).hypot(a[2] - b[2]) / frames * FPS;
-                let low = poses[t][j][1] - lowest[k] < CONTACT_BAND_M;
+            let low: [bool; 4] = std::array::from_fn(|k| {
+                down[k] && poses[t][FEET[k]][1] - lowest[k] < CONTACT_BAND_M
+            });
+            let mut contact: [bool; 4] = std::array::from_fn(|k| {
                 let marked = row[CONTACTS.start + k] > 0.5;
-                lowest[k] - ground < NEVER_DOWN_M && low && (marked || speed < PLANT_SPEED)
+                let slow = horizontal_speed(poses, FEET[k], t) < PLANT_SPEED;
+                low[k] && (marked || slow)
+            });
+            // A body near the floor stands on something: with no foot joint in contact, the
+            // low joints of the lower foot carry it (a generated run's stance foot slides
+            // with the body and is marked as lifted).
+            if !contact.iter().any(|&c| c) && low.iter().any(|&l| l) {
+                let height = |leg: &Leg| {
+                    leg.feet
+                        .iter()
+                        .map(|&k| poses[t][FEET[k]][1] - lowest[k])
+                        .fold(f64::INFINITY, f64::min)
+                };
+                let leg = if height(&LEGS[0]) <= height(&LEGS[1]) {
+                    &LEGS[0]
+                } else {
+                    &LEGS[1]
+                };
+                for &k in &leg.feet {
+                    contact[k] = low[k];
+                }
+            }
+            contact
+        })
+        .collect()
+}
+
+/// Each foot joint's lowest height over the motion, and whether it comes down to the floor at
+/// all (within [`NEVER_DOWN_M`] of the lowest foot point).
+fn lowest_points(poses: &[Pose]) -> ([f64; 4], [bool; 4]) {
+    let lowest = FEET.map(|j| poses.iter().map(|p| p[j][1]).fold(f64::INFINITY, f64::min));
+    let ground = lowest.iter().copied().fold(f64::INFINITY, f64::min);
+    (lowest, lowest.map(|l| l - ground < NEVER_DOWN_M))
+}
+
+/// Joint `j`'s horizontal speed at frame `t` (m/s), by central differences.
+fn horizontal_speed(poses: &[Pose], j: usize, t: usize) -> f64 {
+    let (before, after) = (t.saturating_sub(1), (t + 1).min(poses.len() - 1));
+    let (a, b) = (poses[before][j], poses[after][j]);
+    (a[0] - b[0]).hypot(a[2] - b[2]) / (after - before).max(1) as f64 * FPS
+}
+
+/// Per frame and leg, how far (metres) to raise the foot so that a foot joint that is not
+/// planted (`planted`: inside one of its contact spans) clears its resting height (`floors`)
+/// by [`SWING_CLEARANCE_M`]: a swing that skims the floor, the commonest slide of a generated
+/// walk, and the steps cut into a long slide; only while the other foot is planted. Eased in
+/// and out over [`BLEND_FRAMES`] so the foot rises and sets down smoothly.
+fn swing_lifts(poses: &[Pose], planted: &[[bool; 4]], floors: [f64; 4]) -> Vec<[f64; 2]> {
+    let (_, down) = lowest_points(poses);
+    let needed: Vec<[f64; 2]> = (0..poses.len())
+        .map(|t| {
+            let standing = LEGS.map(|leg| leg.feet.iter().any(|&k| planted[t][k]));
+            std::array::from_fn(|side| {
+                // Only a foot whose other foot stands is lifted: with neither planted (a run
+                // between stances), lifting would leave the body floating.
+                if !standing[1 - side] {
+                    return 0.0;
+                }
+                LEGS[side]
+                    .feet
+                    .iter()
+                    .filter(|&&k| down[k] && !planted[t][k])
+                    .map(|&k| floors[k] + SWING_CLEARANCE_M - poses[t][FEET[k]][1])
+                    .fold(0.0, f64::max)
+            })
+        })
+        .collect();
+    let reach = (BLEND_FRAMES + 1) as f64;
+    (0..poses.len())
+        .map(|t| {
+            let lo = t.saturating_sub(BLEND_FRAMES);
+            let hi = (t + BLEND_FRAMES).min(poses.len() - 1);
+            std::array::from_fn(|leg| {
+                (lo..=hi)
+                    .map(|u| needed[u][leg] * geom::ease(1.0 - t.abs_diff(u) as f64 / reach))
+                    .fold(0.0, f64::max)
             })
         })
         .collect()
 }
 
 /// The contact spans of one foot joint: runs of contact frames (a one-frame gap is closed),
-/// each pinned where the joint is on average over it, horizontally, at its median height.
-/// Spans whose pin would move the joint more than [`MAX_PIN_OFFSET_M`] are left out.
+/// each pinned where the joint is on average over it, horizontally, at its median height. A
+/// run along which the joint travels further than [`STEP_M`] is a foot that slides while it
+/// should stand: it is cut into stances of at most that travel, with [`STEP_GAP_FRAMES`]
+/// between them for the foot to step from one to the next. Stances of one frame pin nothing
+/// and are left out.
 fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
     let mut on = contact.to_vec();
     for t in 1..on.len().saturating_sub(1) {
@@ -109,6 +189,7 @@ fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
             on[t] = true;
         }
     }
+    let flat = |a: Vec3, b: Vec3| (a[0] - b[0]).hypot(a[2] - b[2]);
     let mut out = Vec::new();
     let mut t = 0;
     while t < on.len() {
@@ -117,11 +198,19 @@ fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
             continue;
         }
         let start = t;
-        while t + 1 < on.len() && on[t + 1] {
+        while t + 1 < on.len() && on[t + 1] && flat(positions[t + 1], positions[start]) <= STEP_M {
             t += 1;
         }
         let end = t;
-        t += 1;
+        // Cut short by its travel: the next stance starts after a step.
+        t += if t + 1 < on.len() && on[t + 1] {
+            1 + STEP_GAP_FRAMES
+        } else {
+            1
+        };
+        if end == start {
+            continue;
+        }
         let frames = &positions[start..=end];
         let count = frames.len() as f64;
         let mut heights: Vec<f64> = frames.iter().map(|p| p[1]).collect();
@@ -131,12 +220,7 @@ fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
             heights[heights.len() / 2],
             frames.iter().map(|p| p[2]).sum::<f64>() / count,
         ];
-        let far = frames
-            .iter()
-            .any(|p| geom::dist(*p, pin) > MAX_PIN_OFFSET_M);
-        if !far {
-            out.push(Span { start, end, pin });
-        }
+        out.push(Span { start, end, pin });
     }
     out
 }
@@ -256,8 +340,21 @@ pub fn plant_feet(features: &[FeatureFrame]) -> Features {
         })
         .collect();
 
+    // Each foot joint rests at its lowest pin (or, never pinned, at its lowest point).
+    let floors: [f64; 4] = std::array::from_fn(|k| {
+        spans[k]
+            .iter()
+            .map(|s| s.pin[1] - floor)
+            .reduce(f64::min)
+            .unwrap_or_else(|| lowest_points(&poses).0[k])
+    });
+    let planted: Vec<[bool; 4]> = (0..poses.len())
+        .map(|t| std::array::from_fn(|k| spans[k].iter().any(|s| (s.start..=s.end).contains(&t))))
+        .collect();
+    let lifts = swing_lifts(&poses, &planted, floors);
+
     for (t, pose) in poses.iter_mut().enumerate() {
-        for leg in &LEGS {
+        for (side, leg) in LEGS.iter().enumerate() {
             let [a, b] = leg.feet;
             let ((wa, da), (wb, db)) = (offsets[a][t], offsets[b][t]);
             let (oa, ob) = (geom::scale(da, wa), geom::scale(db, wb));
@@ -268,7 +365,7 @@ pub fn plant_feet(features: &[FeatureFrame]) -> Features {
             let [_, _, ankle, toe] = leg.joints;
             let mut targets = [geom::add(pose[ankle], move_a), geom::add(pose[toe], move_b)];
             for target in &mut targets {
-                target[1] = target[1].max(0.0);
+                target[1] = (target[1] + lifts[t][side]).max(0.0);
             }
             if geom::dist(targets[0], pose[ankle]) > 1e-9
                 || geom::dist(targets[1], pose[toe]) > 1e-9

@@ -23,8 +23,8 @@ pub struct GenerateArgs {
     /// Filmstrip PNG to write.
     #[arg(long)]
     png: Option<PathBuf>,
-    /// Folder for a before/after look at the feet: filmstrips of the motion as decoded and as
-    /// the engine hands it out (feet planted), side view, and its figures printed.
+    /// Folder for a before/after look at the feet: filmstrips and joints of the motion as
+    /// decoded and as the engine hands it out (feet planted), and their figures printed.
     #[arg(long)]
     compare_feet: Option<PathBuf>,
     /// Classifier-free guidance scale of the base transformer: 1 follows the learnt
@@ -70,8 +70,9 @@ fn parse_parts(parts: &[String]) -> Result<Vec<(coma::skeleton::BodyPart, String
         .collect()
 }
 
-/// Writes `before.png` and `after.png` into `dir`: the motion as SPAM decoded it (on the
-/// reference skeleton) and as the engine returned it; prints both motions' foot figures.
+/// Writes `before.png` and `after.png` into `dir`, with their joints as `before.npy` and
+/// `after.npy` ((T, 22, 3), metres): the motion as SPAM decoded it (on the reference skeleton)
+/// and as the engine returned it; prints both motions' foot figures.
 fn compare_feet(
     session: &coma::session::Session,
     motion: &coma::session::Motion,
@@ -100,6 +101,7 @@ fn compare_feet(
             view: View::Side,
         };
         write_filmstrip(&dir.join(format!("{name}.png")), poses, &options)?;
+        coma::features::joints_to_npy(poses).write_f32(dir.join(format!("{name}.npy")))?;
     }
     Ok(())
 }
