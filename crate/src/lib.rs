@@ -12,6 +12,7 @@
 //!  agents                         LLM client, planner, reviewer, the loop (pipeline)
 //!  share  plan                    share links; what the planner hands to the generator
 //!  model  text  trajectory        SPAM, the evaluator, tokens; MiniLM; paths on the ground
+//!  feet  posture                  planted feet of every motion; key postures
 //!  dataset  posecodes  render  bvh  mocap  features  skeleton  timing  geom  rng  npy  …
 //! ```
 //!
