@@ -60,6 +60,31 @@ for heuristic in ("TEMPERANCE", "BLENDER", "FORTUNE"):
               f"vertex groups={len(groups)}")
         if not mods or mods[0].object != arm or groups != sorted(names):
             failed.append("Error: the mesh is not skinned on the 22 bones")
+        # The skin is rigid: posed by Blender, each vertex keeps its distances to its bone's
+        # head and, for a bone with one child, to the child's head, as in the rest pose.
+        group_name = {g.index: g.name for g in body.vertex_groups}
+        anchors = {}
+        for name in names:
+            bone = arm.data.bones[name]
+            anchors[name] = [name] + ([bone.children[0].name] if len(bone.children) == 1 else [])
+        def heads(rest):
+            return {n: arm.matrix_world @ (arm.data.bones[n].head_local if rest else arm.pose.bones[n].head)
+                    for n in names}
+        rest_heads = heads(True)
+        rest = [(body.matrix_world @ v.co, group_name[max(v.groups, key=lambda g: g.weight).group])
+                for v in body.data.vertices]
+        skin_worst = 0.0
+        for f in sorted({0, frames // 3, 2 * frames // 3, frames - 1}):
+            scene.frame_set(f)
+            posed_heads = heads(False)
+            evaluated = body.evaluated_get(bpy.context.evaluated_depsgraph_get())
+            posed = [evaluated.matrix_world @ v.co for v in evaluated.data.vertices]
+            for (r, name), p in zip(rest, posed):
+                for a in anchors[name]:
+                    skin_worst = max(skin_worst, abs((r - rest_heads[a]).length - (p - posed_heads[a]).length))
+        print(f"mesh: skinned vertices keep their distances to their bones within {skin_worst*1000:.3f} mm")
+        if skin_worst > 1e-3:
+            failed.append(f"Error: the skinned mesh deforms by {skin_worst*1000:.2f} mm")
 for message in failed:
     print(message)
 if failed:

@@ -3,8 +3,9 @@
 # writes the motion as .glb and as joints JSON, imports the .glb with Blender's own glTF
 # importer once per bone heuristic (TEMPERANCE, BLENDER, FORTUNE: they turn the bones, not
 # their heads) and compares every bone head, every frame, with the joints (fails beyond
-# 1 mm); also checks the body mesh came in skinned on the 22 bones. Needs Blender:
-# apt-get install blender.
+# 1 mm); also checks the body mesh came in skinned on the 22 bones and that Blender's skinning
+# keeps it rigid on them (each vertex keeps its distances to its bone's joints, 1 mm). Needs
+# Blender and numpy for its glTF importer: apt-get install blender python3-numpy.
 #
 #   scripts/blender_gltf_check.sh motion.npy|.bvh      # any motion file `coma convert` reads
 #   scripts/blender_gltf_check.sh generate "a person waves the left hand" --seed 2 --seconds 5
