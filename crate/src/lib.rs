@@ -13,7 +13,7 @@
 //!  share  plan                    share links; what the planner hands to the generator
 //!  model  text  trajectory        SPAM, the evaluator, tokens; MiniLM; paths on the ground
 //!  feet  posture                  planted feet of every motion; key postures
-//!  dataset  posecodes  render  bvh  mocap  features  skeleton  timing  geom  rng  npy  …
+//!  gltf  dataset  posecodes  render  bvh  mocap  features  figure  skeleton  timing  geom  rng  npy  …
 //! ```
 //!
 //! One prompt, from the text box to the canvas: the page's prompt box sends a
@@ -40,7 +40,9 @@ pub mod executor;
 pub mod export;
 pub mod features;
 pub mod feet;
+pub mod figure;
 pub mod geom;
+pub mod gltf;
 pub mod limb;
 pub mod mocap;
 pub mod model;

@@ -114,6 +114,38 @@ fn convert_to_bvh_and_render_the_bvh() {
 }
 
 #[test]
+fn convert_to_glb_with_either_naming() {
+    let tmp = tempfile::tempdir().unwrap();
+    let features = reference().join("new_joint_vecs/012314.npy");
+    for (flags, hips) in [(&[][..], "pelvis"), (&["--mixamo"][..], "mixamorig:Hips")] {
+        let glb = tmp.path().join("m.glb");
+        let out = coma()
+            .arg("convert")
+            .arg(&features)
+            .arg(&glb)
+            .args(flags)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(&glb).unwrap();
+        assert_eq!(&bytes[..4], b"glTF");
+        let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        assert_eq!(word(8), bytes.len());
+        let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + word(12)]).unwrap();
+        assert_eq!(json["nodes"][0]["name"], hips);
+        // One key per frame of the 170-frame motion.
+        let input = json["animations"][0]["samplers"][0]["input"]
+            .as_u64()
+            .unwrap() as usize;
+        assert_eq!(json["accessors"][input]["count"], 170);
+    }
+}
+
+#[test]
 fn bad_input_files_give_messages_not_panics() {
     let tmp = tempfile::tempdir().unwrap();
     let junk = tmp.path().join("junk.bvh");
