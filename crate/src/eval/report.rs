@@ -98,7 +98,7 @@ fn describe(name: &str) -> &'static str {
         "retrieval" => {
             "the training motion whose caption is nearest (MiniLM cosine) to the test caption"
         }
-        "spam" => "SPAM, one shot, a motion of the test motion's length from the caption",
+        "spam" => "SPAM, one shot, a motion of the test motion's length from the caption, measured as the engine hands it out (on the reference skeleton, feet planted)",
         "spam_review" => {
             "the same, then reviewed (up to K rounds, no LLM) with the evaluator as judge; the \
              judge is the evaluator that measures, so R-precision and MM-Dist favour this row \
