@@ -18,7 +18,7 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import { spawn, execFileSync } from "node:child_process";
-import { existsSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { homedir, tmpdir } from "node:os";
 import { join, resolve } from "node:path";
 import { chromium } from "playwright-core";
@@ -779,12 +779,16 @@ async function still(page, shot) {
   };
 }
 
+/** Where the figure's screenshots go (docs/screenshots by default). */
+const FIGURES = join(SHOTS, "screenshots");
+
 test("the 3D view draws a shaded figure with WebGL2 or Canvas 2D where there is no WebGPU", { timeout: 30 * 60_000 }, async () => {
   const server = serve();
   const plain = await chromium.launch({ executablePath: "/usr/bin/chromium", args: PLAIN_ARGS });
   const gpu = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
   try {
     await waitForServer();
+    mkdirSync(FIGURES, { recursive: true });
     const viewport = { viewport: { width: 1280, height: 800 } };
     // Chromium without WebGPU: the view falls to WebGL2 by itself.
     const first = await open(await plain.newContext(viewport), BASE);
@@ -792,7 +796,7 @@ test("the 3D view draws a shaded figure with WebGL2 or Canvas 2D where there is 
     const made = await walk(first.page, 3);
     await first.page.waitForTimeout(2000);
     const shown = [];
-    const gl = await still(first.page, join(SHOTS, "figure-webgl2.png"));
+    const gl = await still(first.page, join(FIGURES, "figure-webgl2.png"));
     shown.push(["WebGL2", gl]);
 
     // The same motion's link, with the 2D renderer asked for: the prompt box shows the link's
@@ -803,18 +807,18 @@ test("the 3D view draws a shaded figure with WebGL2 or Canvas 2D where there is 
     assert.equal(await second.page.inputValue("#seconds"), "2");
     assert.equal(await second.page.inputValue("#seed"), "3");
     await second.page.waitForTimeout(2000);
-    const flat = await still(second.page, join(SHOTS, "figure-2d.png"));
+    const flat = await still(second.page, join(FIGURES, "figure-2d.png"));
     shown.push(["Canvas 2D", flat]);
     // The skeleton toggle: thin bones instead of the body, far fewer limb pixels.
     await second.page.click("#skeleton");
     await second.page.waitForTimeout(500);
-    const sticks = await still(second.page, join(SHOTS, "figure-2d-skeleton.png"));
+    const sticks = await still(second.page, join(FIGURES, "figure-2d-skeleton.png"));
 
     // Where WebGPU draws (SwiftShader here), for the screenshot beside the others.
     const third = await open(await gpu.newContext(viewport), BASE + "?renderer=webgpu" + made.fragment);
     await shows(third.page, made.hash);
     await third.page.waitForTimeout(2000);
-    const webgpu = await still(third.page, join(SHOTS, "figure-webgpu.png"));
+    const webgpu = await still(third.page, join(FIGURES, "figure-webgpu.png"));
     shown.push(["WebGPU", webgpu]);
 
     for (const [name, s] of shown) {
