@@ -38,6 +38,7 @@ pub mod executor;
 #[cfg(feature = "native")]
 pub mod export;
 pub mod features;
+pub mod figure;
 pub mod geom;
 pub mod mocap;
 pub mod model;

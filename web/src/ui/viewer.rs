@@ -52,7 +52,9 @@ fn now_ms() -> f64 {
 fn current_pose(state: AppState, frame: f64) -> Option<[[f32; 3]; 22]> {
     state.history.with_untracked(|h| {
         let joints = &h.current().as_ref()?.motion.joints;
-        joints.get((frame.max(0.0) as usize).min(joints.len().checked_sub(1)?)).copied()
+        joints
+            .get((frame.max(0.0) as usize).min(joints.len().checked_sub(1)?))
+            .copied()
     })
 }
 
@@ -104,7 +106,9 @@ fn tick(
             }
         });
     }
-    settings.stroke.with_untracked(|s| lines.extend(stroke_lines(s)));
+    settings
+        .stroke
+        .with_untracked(|s| lines.extend(stroke_lines(s)));
     let view_projection = camera.view_projection((css_w / css_h) as f32);
     settings.camera.set_value(camera);
     let drawn = renderer.draw(&Frame {
@@ -124,7 +128,8 @@ fn tick(
     } else {
         let _ = canvas.set_attribute("data-missed", "1");
     }
-    let root = pose.and_then(|p| screen_point(&view_projection, p[0], [css_w as f32, css_h as f32]));
+    let root =
+        pose.and_then(|p| screen_point(&view_projection, p[0], [css_w as f32, css_h as f32]));
     let _ = match root {
         Some([x, y]) => canvas.set_attribute("data-root-px", &format!("{x:.1},{y:.1}")),
         None => canvas.remove_attribute("data-root-px"),
@@ -218,7 +223,9 @@ fn run_renderers(
         };
         let kind = renderer.kind();
         shown.set(Some(kind));
-        state.view_renderer.set(Some((kind.name().to_string(), reasons.join("; "))));
+        state
+            .view_renderer
+            .set(Some((kind.name().to_string(), reasons.join("; "))));
         let rest: Vec<RendererKind> = kinds
             .iter()
             .skip_while(|k| **k != kind)
@@ -227,7 +234,10 @@ fn run_renderers(
             .collect();
         animate(state, canvas, renderer, settings, move |e| {
             let why = format!("{}: {e}", kind.name());
-            state.say(format!("The 3D view's {} renderer stopped ({e}); trying the next one.", kind.name()));
+            state.say(format!(
+                "The 3D view's {} renderer stopped ({e}); trying the next one.",
+                kind.name()
+            ));
             run_renderers(state, holder, rest, settings, shown, problem, vec![why]);
         });
     });
@@ -314,7 +324,15 @@ pub fn Viewer() -> impl IntoView {
         if let Some(note) = &choice.note {
             state.fail(format!("The 3D view: {note}."));
         }
-        run_renderers(state, element, choice.order, settings, shown, problem, Vec::new());
+        run_renderers(
+            state,
+            element,
+            choice.order,
+            settings,
+            shown,
+            problem,
+            Vec::new(),
+        );
     });
     let frames = move || {
         state

@@ -82,7 +82,10 @@ mod tests {
 
     #[test]
     fn without_a_query_the_best_renderer_the_browser_has_comes_first() {
-        assert_eq!(renderer_order(None, true).order, vec![WebGpu, WebGl2, Canvas2d]);
+        assert_eq!(
+            renderer_order(None, true).order,
+            vec![WebGpu, WebGl2, Canvas2d]
+        );
         assert_eq!(renderer_order(None, false).order, vec![WebGl2, Canvas2d]);
         assert_eq!(renderer_order(Some(""), false).note, None);
     }
@@ -90,9 +93,15 @@ mod tests {
     #[test]
     fn the_query_puts_its_renderer_first_and_keeps_the_fallbacks_after_it() {
         assert_eq!(renderer_order(Some("2d"), true).order, vec![Canvas2d]);
-        assert_eq!(renderer_order(Some("webgl2"), true).order, vec![WebGl2, Canvas2d]);
+        assert_eq!(
+            renderer_order(Some("webgl2"), true).order,
+            vec![WebGl2, Canvas2d]
+        );
         // Asked for WebGPU where the browser shows none: it is tried (and says why it fails).
-        assert_eq!(renderer_order(Some("WebGPU"), false).order, vec![WebGpu, WebGl2, Canvas2d]);
+        assert_eq!(
+            renderer_order(Some("WebGPU"), false).order,
+            vec![WebGpu, WebGl2, Canvas2d]
+        );
     }
 
     #[test]

@@ -67,7 +67,11 @@ pub fn flat_triangles(vertices: &[Vertex], m: &Mat4, eye: V3, size: [f32; 2]) ->
         out.push(FlatTriangle {
             points,
             depth,
-            rgb: [to_u8(color[0] * k), to_u8(color[1] * k), to_u8(color[2] * k)],
+            rgb: [
+                to_u8(color[0] * k),
+                to_u8(color[1] * k),
+                to_u8(color[2] * k),
+            ],
             alpha: color[3].clamp(0.0, 1.0),
         });
     }
@@ -200,8 +204,9 @@ mod tests {
                 .map(|d| lit([t[0] + d[0], t[1] + d[1], t[2]], normal))
         };
         // The camera looks from +Z: a face whose normal is -Z faces away.
-        assert!(flat_triangles(&tri([0.0, 0.0, -1.0]), &m, camera.eye(), [100.0, 100.0])
-            .is_empty());
+        assert!(
+            flat_triangles(&tri([0.0, 0.0, -1.0]), &m, camera.eye(), [100.0, 100.0]).is_empty()
+        );
         let front = flat_triangles(&tri([0.0, 0.0, 1.0]), &m, camera.eye(), [100.0, 100.0]);
         let up = flat_triangles(&tri([0.0, 1.0, 0.1]), &m, camera.eye(), [100.0, 100.0]);
         assert_eq!((front.len(), up.len()), (1, 1));
@@ -217,15 +222,23 @@ mod tests {
         let m = camera.view_projection(1.5);
         let eye = camera.eye();
         let behind = [eye[0] * 2.0, eye[1], eye[2] * 2.0];
-        let tri = [lit(behind, UNLIT), lit(camera.target, UNLIT), lit([0.0, 0.0, 0.0], UNLIT)];
+        let tri = [
+            lit(behind, UNLIT),
+            lit(camera.target, UNLIT),
+            lit([0.0, 0.0, 0.0], UNLIT),
+        ];
         assert!(flat_triangles(&tri, &m, eye, [300.0, 200.0]).is_empty());
         let line = [lit(behind, UNLIT), lit(camera.target, UNLIT)];
         let flat = flat_lines(&line, &m, [300.0, 200.0]);
         assert_eq!(flat.len(), 1);
         assert!((flat[0].to[0] - 150.0).abs() < 1e-2 && (flat[0].to[1] - 100.0).abs() < 1e-2);
         assert!(flat[0].from.iter().all(|v| v.is_finite()));
-        assert!(flat_lines(&[lit(behind, UNLIT), lit(behind, UNLIT)], &m, [300.0, 200.0])
-            .is_empty());
+        assert!(flat_lines(
+            &[lit(behind, UNLIT), lit(behind, UNLIT)],
+            &m,
+            [300.0, 200.0]
+        )
+        .is_empty());
     }
 
     #[test]

@@ -124,7 +124,10 @@ impl GpuRenderer {
         let failure = Arc::new(Mutex::new(None));
         let lost = failure.clone();
         device.set_device_lost_callback(move |reason, message| {
-            keep_first(&lost, format!("the {name} device was lost ({reason:?}: {message})"));
+            keep_first(
+                &lost,
+                format!("the {name} device was lost ({reason:?}: {message})"),
+            );
         });
         let invalid = failure.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
@@ -187,8 +190,7 @@ impl GpuRenderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let attributes =
-            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4];
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4];
         let pipeline = |topology: wgpu::PrimitiveTopology| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("viewer"),

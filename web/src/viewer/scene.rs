@@ -1,6 +1,6 @@
-//! What the viewer draws, as plain coloured vertices: the figure of one frame (a shaded body
-//! of tapered limbs and round joints, or on a toggle the skeleton: bones as ribbons facing the
-//! camera, joints as small squares; the four limbs in their colours), soft contact shadows
+//! What the viewer draws, as plain coloured vertices: the figure of one frame (a shaded body,
+//! coma's figure mesh, or on a toggle the skeleton: bones as ribbons facing the camera, joints
+//! as small squares; the four limbs in their colours), soft contact shadows
 //! under the feet and the pelvis, the ground grid and the root's path; the light that shades
 //! the body; and the orbit camera that looks at it all. No GPU here, so it is tested natively.
 //!
@@ -341,17 +341,6 @@ pub fn skeleton_triangles(pose: &[V3; 22], camera: &OrbitCamera) -> Vec<Vertex> 
     out
 }
 
-/// Radius of the body around each joint (metres), in joint order: what makes the figure's
-/// volume. The head's is the skull's; it sits above the head joint (see [`figure_triangles`]).
-const JOINT_RADIUS: [f32; 22] = [
-    0.10, 0.08, 0.08, 0.10, 0.055, 0.055, 0.105, 0.045, 0.045, 0.11, 0.035, 0.035, 0.05, 0.06,
-    0.06, 0.1, 0.05, 0.05, 0.04, 0.04, 0.035, 0.035,
-];
-/// Sides of a limb's tube and segments of a joint's ball: round enough to shade smoothly,
-/// few enough that the 2D renderer sorts and fills them every frame.
-const SIDES: usize = 10;
-const RINGS: usize = 5;
-
 /// A body-part colour as the shaded figure's tint: the limbs' colours lightened a little and
 /// the torso's dark grey a lot, so shading shows on every part.
 pub fn tint(c: [u8; 3], torso: bool) -> [f32; 4] {
@@ -368,139 +357,35 @@ fn is_limb_color(c: [u8; 3]) -> bool {
     coma::render::PART_COLORS.iter().any(|(_, p)| *p == c)
 }
 
-/// Two unit vectors perpendicular to unit `axis` and to each other.
-fn perpendiculars(axis: V3) -> (V3, V3) {
-    let helper = if axis[1].abs() < 0.9 {
-        [0.0, 1.0, 0.0]
-    } else {
-        [1.0, 0.0, 0.0]
-    };
-    let u = normalize(cross(axis, helper));
-    (u, cross(axis, u))
-}
-
-fn push_lit(out: &mut Vec<Vertex>, position: V3, normal: V3, color: [f32; 4]) {
-    out.push(Vertex {
-        position,
-        normal,
-        color,
-    });
-}
-
-/// A tube from `a` (radius `ra`) to `b` (radius `rb`), open at both ends (the joints' balls
-/// close them), with normals tilted by the taper.
-fn tube(out: &mut Vec<Vertex>, a: V3, b: V3, ra: f32, rb: f32, color: [f32; 4]) {
-    let along = sub(b, a);
-    let len = dot(along, along).sqrt();
-    if len < 1e-5 || !len.is_finite() {
-        return;
-    }
-    let axis = scale(along, 1.0 / len);
-    let (u, v) = perpendiculars(axis);
-    let slope = (ra - rb) / len;
-    let ring = |i: usize| {
-        let t = i as f32 / SIDES as f32 * std::f32::consts::TAU;
-        let radial = add(scale(u, t.cos()), scale(v, t.sin()));
-        (radial, normalize(add(radial, scale(axis, slope))))
-    };
-    for i in 0..SIDES {
-        let (r0, n0) = ring(i);
-        let (r1, n1) = ring(i + 1);
-        let (a0, a1) = (add(a, scale(r0, ra)), add(a, scale(r1, ra)));
-        let (b0, b1) = (add(b, scale(r0, rb)), add(b, scale(r1, rb)));
-        for (p, n) in [(a0, n0), (a1, n1), (b1, n1), (a0, n0), (b1, n1), (b0, n0)] {
-            push_lit(out, p, n, color);
-        }
-    }
-}
-
-/// A ball of radius `r` around `c`.
-fn ball(out: &mut Vec<Vertex>, c: V3, r: f32, color: [f32; 4]) {
-    let point = |ring: usize, seg: usize| {
-        let lat = std::f32::consts::PI * ring as f32 / RINGS as f32;
-        let lon = std::f32::consts::TAU * seg as f32 / SIDES as f32;
-        let n = [lat.sin() * lon.cos(), lat.cos(), lat.sin() * lon.sin()];
-        (add(c, scale(n, r)), n)
-    };
-    for ring in 0..RINGS {
-        for seg in 0..SIDES {
-            let (p00, n00) = point(ring, seg);
-            let (p01, n01) = point(ring, seg + 1);
-            let (p10, n10) = point(ring + 1, seg);
-            let (p11, n11) = point(ring + 1, seg + 1);
-            // The poles' rings collapse to a point: one triangle there, not two.
-            if ring > 0 {
-                for (p, n) in [(p00, n00), (p11, n11), (p10, n10)] {
-                    push_lit(out, p, n, color);
-                }
-            }
-            if ring + 1 < RINGS {
-                for (p, n) in [(p00, n00), (p01, n01), (p11, n11)] {
-                    push_lit(out, p, n, color);
-                }
-            }
-        }
-    }
-}
-
-/// Triangles of the shaded figure of one pose (22 joints, metres): a tapered tube per bone,
-/// a ball per joint, a larger ball for the skull above the head joint and one for each hand
-/// beyond the wrist, lit (every vertex has its normal), tinted with the body parts' colours
-/// ([`tint`]). Joints that are not numbers leave their bones out.
+/// Triangles of the shaded figure of one pose (22 joints, metres): the body mesh of
+/// [`coma::figure::figure_mesh`] (capsules around the bones, a head, hands and feet), lit (every
+/// vertex has its normal), each vertex tinted ([`tint`]) with the colour of the body part its
+/// joint belongs to. Triangles with a corner that is not a number (from joints that are not)
+/// are left out.
 pub fn figure_triangles(pose: &[V3; 22]) -> Vec<Vertex> {
-    let mut out = Vec::with_capacity(21 * SIDES * 6 + 25 * SIDES * (2 * RINGS - 2) * 3);
-    let finite = |p: &V3| p.iter().all(|v| v.is_finite());
-    for (child, parent) in PARENTS.iter().enumerate() {
-        let Some(p) = *parent else { continue };
-        if !finite(&pose[p]) || !finite(&pose[child]) {
-            continue;
-        }
-        let c = bone_color(p, child);
-        // The neck keeps its width up to the skull.
-        let rb = if child == 15 {
-            JOINT_RADIUS[12]
-        } else {
-            JOINT_RADIUS[child]
-        };
-        tube(
-            &mut out,
-            pose[p],
-            pose[child],
-            JOINT_RADIUS[p],
-            rb,
-            tint(c, !is_limb_color(c)),
+    let mesh = coma::figure::figure_mesh(pose);
+    let vertex = |i: u32| {
+        let i = i as usize;
+        let (position, normal, joint) = (
+            *mesh.positions.get(i)?,
+            *mesh.normals.get(i)?,
+            *mesh.joints.get(i)? as usize,
         );
-    }
-    for (j, p) in pose.iter().enumerate() {
-        if !finite(p) {
-            continue;
-        }
-        let c = joint_color(j);
-        let color = tint(c, !is_limb_color(c));
-        ball(&mut out, *p, JOINT_RADIUS[j], color);
-    }
-    // The skull: above the head joint, along the neck.
-    if finite(&pose[12]) && finite(&pose[15]) {
-        let up = normalize(sub(pose[15], pose[12]));
-        let c = joint_color(15);
-        ball(
-            &mut out,
-            add(pose[15], scale(up, 0.06)),
-            0.1,
-            tint(c, !is_limb_color(c)),
-        );
-    }
-    // The hands: past the wrists, along the forearms.
-    for (elbow, wrist) in [(18, 20), (19, 21)] {
-        if finite(&pose[elbow]) && finite(&pose[wrist]) {
-            let along = normalize(sub(pose[wrist], pose[elbow]));
-            let c = joint_color(wrist);
-            ball(
-                &mut out,
-                add(pose[wrist], scale(along, 0.07)),
-                0.045,
-                tint(c, false),
-            );
+        let c = joint_color(joint);
+        position
+            .iter()
+            .chain(&normal)
+            .all(|v| v.is_finite())
+            .then(|| Vertex {
+                position,
+                normal,
+                color: tint(c, !is_limb_color(c)),
+            })
+    };
+    let mut out = Vec::with_capacity(mesh.indices.len());
+    for tri in mesh.indices.chunks_exact(3) {
+        if let (Some(a), Some(b), Some(c)) = (vertex(tri[0]), vertex(tri[1]), vertex(tri[2])) {
+            out.extend([a, b, c]);
         }
     }
     out
@@ -532,9 +417,9 @@ pub struct Shadow {
 /// Height above the floor (metres) at which a foot's shadow has faded away.
 pub const SHADOW_FADE_M: f32 = 0.45;
 /// Opacity of a planted foot's shadow at its centre.
-const FOOT_SHADOW_ALPHA: f32 = 0.42;
+const FOOT_SHADOW_ALPHA: f32 = 0.55;
 /// Opacity of the faint shadow under the pelvis.
-const PELVIS_SHADOW_ALPHA: f32 = 0.13;
+const PELVIS_SHADOW_ALPHA: f32 = 0.16;
 
 /// The contact shadows of a pose: one under each foot (along the foot, fading and widening
 /// as the foot rises, gone at [`SHADOW_FADE_M`]) and a faint round one under the pelvis.
@@ -890,7 +775,9 @@ mod tests {
         for (fan, s) in tris.chunks(SHADOW_POINTS * 3).zip(&shadows) {
             assert_eq!(fan[0].color, [0.0, 0.0, 0.0, s.alpha]);
             assert_eq!(fan[1].color[3], 0.0);
-            assert!(fan.iter().all(|v| v.position[1] == SHADOW_Y && v.normal == UNLIT));
+            assert!(fan
+                .iter()
+                .all(|v| v.position[1] == SHADOW_Y && v.normal == UNLIT));
             // Rim points lie on the ellipse: along the axis at the long radius.
             let p = s.rim_point(0.0, 1.0);
             let d = [p[0] - s.center[0], p[2] - s.center[1]];
