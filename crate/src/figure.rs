@@ -63,13 +63,6 @@ struct Part {
     aspect: [f32; 2],
 }
 
-impl Part {
-    /// The largest distance of the part's surface from its axis segment (metres).
-    fn max_radius(&self) -> f32 {
-        self.ra.max(self.rb) * self.aspect[0].max(self.aspect[1]).max(1.0)
-    }
-}
-
 /// Most triangles a figure has (the parts are fixed: 26 capsules).
 pub const MAX_TRIANGLES: usize = 26 * PART_TRIANGLES;
 
@@ -322,6 +315,11 @@ mod tests {
         pose
     }
 
+    /// The largest distance of a part's surface from its axis segment (metres).
+    fn max_radius(part: &Part) -> f32 {
+        part.ra.max(part.rb) * part.aspect[0].max(part.aspect[1]).max(1.0)
+    }
+
     fn distance_to_segment(p: V3, a: V3, b: V3) -> (f32, V3) {
         let ab = sub(b, a);
         let t = if dot(ab, ab) > 0.0 {
@@ -411,8 +409,8 @@ mod tests {
         let mesh = figure_mesh(&pose);
         for (p, part) in mesh.positions.iter().zip(part_of_vertices(&pose)) {
             let (dist, _) = distance_to_segment(*p, part.a, part.b);
-            assert!(dist <= part.max_radius() + 1e-5, "{dist} from the axis");
-            assert!(part.max_radius() <= 0.16);
+            assert!(dist <= max_radius(&part) + 1e-5, "{dist} from the axis");
+            assert!(max_radius(&part) <= 0.16);
         }
         // Each bone part's axis is the bone itself: the joint's own position starts it.
         for part in parts(&pose) {

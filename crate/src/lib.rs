@@ -12,7 +12,7 @@
 //!  agents                         LLM client, planner, reviewer, the loop (pipeline)
 //!  share  plan                    share links; what the planner hands to the generator
 //!  model  text  trajectory        SPAM, the evaluator, tokens; MiniLM; paths on the ground
-//!  dataset  posecodes  render  bvh  mocap  features  skeleton  timing  geom  rng  npy  …
+//!  gltf  dataset  posecodes  render  bvh  mocap  features  figure  skeleton  timing  geom  rng  npy  …
 //! ```
 //!
 //! One prompt, from the text box to the canvas: the page's prompt box sends a
@@ -40,6 +40,7 @@ pub mod export;
 pub mod features;
 pub mod figure;
 pub mod geom;
+pub mod gltf;
 pub mod mocap;
 pub mod model;
 pub mod motion_file;

@@ -1,9 +1,10 @@
 //! Motion files on disk: reading a motion from `.npy` (HumanML3D features or joints) or `.bvh`,
-//! and writing it as `.bvh`, `.npy` or `.json`. Every reader returns 22-joint poses at 20 fps in
+//! and writing it as `.bvh`, `.npy`, `.json` or `.glb` (glTF binary, [`crate::gltf`]). Every reader returns 22-joint poses at 20 fps in
 //! metres.
 
 use crate::bvh::{self, Bvh};
 use crate::features::{self, FEATURE_DIM};
+use crate::gltf::{self, JointNames};
 use crate::npy::NpyArray;
 use crate::skeleton::{Pose, JOINT_NAMES, NUM_JOINTS};
 use crate::timing::FPS;
@@ -82,12 +83,39 @@ pub fn joints_to_json(poses: &[Pose]) -> serde_json::Value {
     })
 }
 
-/// Writes a motion as `.bvh`, `.json` (joints), or `.npy` (features when the motion has them
-/// or `as_features` asks for them, joints otherwise).
+/// Writes a motion as `.bvh`, `.json` (joints), `.glb` (a skinned figure with the motion as
+/// its animation, joints named as in [`JOINT_NAMES`]) or `.npy` (features when the motion has
+/// them or `as_features` asks for them, joints otherwise).
 pub fn write_motion(path: &Path, motion: &MotionData, as_features: bool) -> Result<()> {
+    write_motion_with(
+        path,
+        motion,
+        WriteOptions {
+            as_features,
+            ..WriteOptions::default()
+        },
+    )
+}
+
+/// The choices [`write_motion_with`] takes beyond the file's extension.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// `.npy`: write HumanML3D features even when the motion holds joints.
+    pub as_features: bool,
+    /// `.glb`: how the joint nodes are named (SMPL's lower-case names or Mixamo's).
+    pub joint_names: JointNames,
+}
+
+/// [`write_motion`] with every choice spelled out.
+pub fn write_motion_with(path: &Path, motion: &MotionData, options: WriteOptions) -> Result<()> {
     let ext = extension(path);
+    let as_features = options.as_features;
     match ext.as_str() {
         "bvh" => std::fs::write(path, bvh::writer::write_bvh(&motion.joints(), FPS)?)?,
+        "glb" => std::fs::write(
+            path,
+            gltf::write_glb(&motion.joints(), FPS, options.joint_names)?,
+        )?,
         "json" => std::fs::write(
             path,
             serde_json::to_string(&joints_to_json(&motion.joints()))?,
@@ -105,7 +133,7 @@ pub fn write_motion(path: &Path, motion: &MotionData, as_features: bool) -> Resu
             array.write_f32(path)?
         }
         _ => bail!(
-            "{}: unknown output format (expected .bvh, .json or .npy)",
+            "{}: unknown output format (expected .bvh, .glb, .json or .npy)",
             path.display()
         ),
     }

@@ -1,5 +1,6 @@
 //! The page's downloads, as bytes: BVH (our 22-joint skeleton at 20 fps, importable by
-//! Blender), JSON (joints per frame with the prompt and the plan) and NPY (HumanML3D's 263
+//! Blender), glTF binary (the shaded figure skinned on that skeleton, with the motion as its
+//! animation), JSON (joints per frame with the prompt and the plan) and NPY (HumanML3D's 263
 //! features, or the (T, 22, 3) joints).
 
 use crate::take::Take;
@@ -11,14 +12,16 @@ use coma::timing::FPS;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
     Bvh,
+    Glb,
     Json,
     FeaturesNpy,
     JointsNpy,
 }
 
 impl Format {
-    pub const ALL: [Format; 4] = [
+    pub const ALL: [Format; 5] = [
         Format::Bvh,
+        Format::Glb,
         Format::Json,
         Format::FeaturesNpy,
         Format::JointsNpy,
@@ -28,6 +31,7 @@ impl Format {
     pub fn label(self) -> &'static str {
         match self {
             Format::Bvh => "BVH",
+            Format::Glb => "glTF (.glb)",
             Format::Json => "JSON",
             Format::FeaturesNpy => "NPY (features)",
             Format::JointsNpy => "NPY (joints)",
@@ -38,6 +42,7 @@ impl Format {
     pub fn file_name(self) -> &'static str {
         match self {
             Format::Bvh => "motion.bvh",
+            Format::Glb => "motion.glb",
             Format::Json => "motion.json",
             Format::FeaturesNpy => "motion-features.npy",
             Format::JointsNpy => "motion-joints.npy",
@@ -48,6 +53,7 @@ impl Format {
     pub fn mime(self) -> &'static str {
         match self {
             Format::Bvh => "text/plain",
+            Format::Glb => "model/gltf-binary",
             Format::Json => "application/json",
             _ => "application/octet-stream",
         }
@@ -68,6 +74,8 @@ pub fn export(take: &Take, format: Format) -> Result<Vec<u8>, String> {
         Format::Bvh => coma::bvh::writer::write_bvh(&poses(take), FPS)
             .map(String::into_bytes)
             .map_err(|e| format!("cannot write BVH: {e}")),
+        Format::Glb => coma::gltf::write_glb(&poses(take), FPS, coma::gltf::JointNames::Smpl)
+            .map_err(|e| format!("cannot write glTF: {e}")),
         Format::Json => {
             let mut json = coma::motion_file::joints_to_json(&poses(take));
             json["prompt"] = take.prompt.clone().into();
@@ -135,6 +143,12 @@ mod tests {
         let bvh = String::from_utf8(export(&t, Format::Bvh).unwrap()).unwrap();
         let parsed = coma::bvh::Bvh::parse(&bvh).unwrap();
         assert_eq!(parsed.frames.len(), 10);
+        let glb = export(&t, Format::Glb).unwrap();
+        assert_eq!(&glb[..4], b"glTF");
+        assert_eq!(
+            u32::from_le_bytes(glb[8..12].try_into().unwrap()) as usize,
+            glb.len()
+        );
         let json: serde_json::Value =
             serde_json::from_slice(&export(&t, Format::Json).unwrap()).unwrap();
         assert_eq!(json["frames"].as_array().unwrap().len(), 10);

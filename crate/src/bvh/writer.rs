@@ -40,7 +40,8 @@ fn end_site(j: usize) -> Vec3 {
     }
 }
 
-fn children(j: usize) -> Vec<usize> {
+/// The joints whose parent is `j`, in index order.
+pub(crate) fn children(j: usize) -> Vec<usize> {
     (0..NUM_JOINTS).filter(|&c| PARENTS[c] == Some(j)).collect()
 }
 
@@ -53,64 +54,105 @@ fn triad(left: Vec3, right: Vec3, up: Vec3) -> Quat {
     Quat::from_columns(x, y, z)
 }
 
-/// World rotation of every joint in one pose, given the rest offsets of the skeleton.
-fn global_rotations(pose: &Pose, offsets: &[Vec3; NUM_JOINTS]) -> [Quat; NUM_JOINTS] {
-    let mut g = [Quat::IDENTITY; NUM_JOINTS];
-    for j in 0..NUM_JOINTS {
-        g[j] = match j {
-            joint::PELVIS => triad(
-                pose[joint::L_HIP],
-                pose[joint::R_HIP],
-                geom::sub(pose[joint::SPINE1], pose[0]),
-            ),
-            joint::SPINE3 => triad(
-                pose[joint::L_COLLAR],
-                pose[joint::R_COLLAR],
-                geom::sub(pose[joint::NECK], pose[joint::SPINE3]),
-            ),
-            _ => {
-                let parent = g[PARENTS[j].expect("non-root joint")];
-                match children(j).as_slice() {
-                    [c] => {
-                        let local_dir = parent.inv().rotate(geom::sub(pose[*c], pose[j]));
-                        parent.mul(Quat::between(offsets[*c], local_dir))
-                    }
-                    _ => parent,
-                }
-            }
-        };
-    }
-    g
+/// The rigid skeleton a motion is exported on (BVH here, glTF in [`crate::gltf`]) and the
+/// rotations that pose it: rest offsets fitted to the motion, and per frame the joint
+/// rotations solved from the joint positions (see the module's documentation). In the rest
+/// pose every rotation is the identity; posing joint `j` with its rotations puts each child
+/// `c` at `pose[j] + global[j] · offsets[c]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rig {
+    /// Each joint's offset from its parent in the rest pose (metres, Y up); the pelvis's is
+    /// zero.
+    pub offsets: [Vec3; NUM_JOINTS],
 }
 
-/// Rest offsets (metres) of the skeleton that best fits the motion.
-fn rest_offsets(poses: &[Pose]) -> [Vec3; NUM_JOINTS] {
-    let n = poses.len() as f64;
-    let mut offsets = [[0.0; 3]; NUM_JOINTS];
-    for c in 1..NUM_JOINTS {
-        let p = PARENTS[c].expect("non-root joint");
-        let length = poses
-            .iter()
-            .map(|pose| geom::dist(pose[c], pose[p]))
-            .sum::<f64>()
-            / n;
-        offsets[c] = geom::scale(rest_direction(c), length);
-    }
-    // Bones hanging off the pelvis and the upper spine keep their average placement in the
-    // parent's frame; the parent's frame itself does not depend on these offsets.
-    for parent in [joint::PELVIS, joint::SPINE3] {
-        let mut sums = [[0.0; 3]; NUM_JOINTS];
-        for pose in poses {
-            let g = global_rotations(pose, &offsets)[parent].inv();
+impl Rig {
+    /// The skeleton that best fits the motion: mean bone lengths along the rest directions,
+    /// the hips and collars at their mean placement relative to the pelvis and upper spine.
+    /// `poses` must not be empty.
+    pub fn fit(poses: &[Pose]) -> Rig {
+        let n = poses.len() as f64;
+        let mut rig = Rig {
+            offsets: [[0.0; 3]; NUM_JOINTS],
+        };
+        for c in 1..NUM_JOINTS {
+            let p = PARENTS[c].expect("non-root joint");
+            let length = poses
+                .iter()
+                .map(|pose| geom::dist(pose[c], pose[p]))
+                .sum::<f64>()
+                / n;
+            rig.offsets[c] = geom::scale(rest_direction(c), length);
+        }
+        // Bones hanging off the pelvis and the upper spine keep their average placement in
+        // the parent's frame; the parent's frame itself does not depend on these offsets.
+        for parent in [joint::PELVIS, joint::SPINE3] {
+            let mut sums = [[0.0; 3]; NUM_JOINTS];
+            for pose in poses {
+                let g = rig.global_rotations(pose)[parent].inv();
+                for c in children(parent) {
+                    sums[c] = geom::add(sums[c], g.rotate(geom::sub(pose[c], pose[parent])));
+                }
+            }
             for c in children(parent) {
-                sums[c] = geom::add(sums[c], g.rotate(geom::sub(pose[c], pose[parent])));
+                rig.offsets[c] = geom::scale(sums[c], 1.0 / n);
             }
         }
-        for c in children(parent) {
-            offsets[c] = geom::scale(sums[c], 1.0 / n);
-        }
+        rig
     }
-    offsets
+
+    /// World rotation of every joint in one pose (from the rest pose). The pelvis and the
+    /// upper spine turn with the triangle of their three bones; every other joint with
+    /// a single child takes the shortest rotation from its parent's that points its bone at
+    /// the child; leaves (head, wrists, toes) keep their parent's.
+    pub fn global_rotations(&self, pose: &Pose) -> [Quat; NUM_JOINTS] {
+        let mut g = [Quat::IDENTITY; NUM_JOINTS];
+        for j in 0..NUM_JOINTS {
+            g[j] = match j {
+                joint::PELVIS => triad(
+                    pose[joint::L_HIP],
+                    pose[joint::R_HIP],
+                    geom::sub(pose[joint::SPINE1], pose[0]),
+                ),
+                joint::SPINE3 => triad(
+                    pose[joint::L_COLLAR],
+                    pose[joint::R_COLLAR],
+                    geom::sub(pose[joint::NECK], pose[joint::SPINE3]),
+                ),
+                _ => {
+                    let parent = g[PARENTS[j].expect("non-root joint")];
+                    match children(j).as_slice() {
+                        [c] => {
+                            let local_dir = parent.inv().rotate(geom::sub(pose[*c], pose[j]));
+                            parent.mul(Quat::between(self.offsets[*c], local_dir))
+                        }
+                        _ => parent,
+                    }
+                }
+            };
+        }
+        g
+    }
+
+    /// Each joint's rotation relative to its parent's (the pelvis's is its world rotation),
+    /// as BVH channels and glTF nodes carry them.
+    pub fn local_rotations(&self, pose: &Pose) -> [Quat; NUM_JOINTS] {
+        let g = self.global_rotations(pose);
+        std::array::from_fn(|j| match PARENTS[j] {
+            None => g[j],
+            Some(p) => g[p].inv().mul(g[j]),
+        })
+    }
+
+    /// The joints of the rest pose (metres) with the pelvis at `root`.
+    pub fn rest_pose(&self, root: Vec3) -> Pose {
+        let mut pose = [root; NUM_JOINTS];
+        for j in 1..NUM_JOINTS {
+            let p = PARENTS[j].expect("non-root joint");
+            pose[j] = geom::add(pose[p], self.offsets[j]);
+        }
+        pose
+    }
 }
 
 /// `Z Y X` Euler angles in degrees of a rotation: `R = Rz(z) · Ry(y) · Rx(x)`.
@@ -140,10 +182,10 @@ pub fn write_bvh(poses: &[Pose], fps: f64) -> Result<String, BvhError> {
             message: format!("frame {t} has a non-finite joint position"),
         });
     }
-    let offsets = rest_offsets(poses);
+    let rig = Rig::fit(poses);
     let mut order = Vec::with_capacity(NUM_JOINTS);
     let mut out = String::from("HIERARCHY\n");
-    write_joint(&mut out, 0, 0, &offsets, &mut order);
+    write_joint(&mut out, 0, 0, &rig.offsets, &mut order);
     let _ = writeln!(
         out,
         "MOTION\nFrames: {}\nFrame Time: {:.8}",
@@ -151,14 +193,10 @@ pub fn write_bvh(poses: &[Pose], fps: f64) -> Result<String, BvhError> {
         1.0 / fps
     );
     for pose in poses {
-        let g = global_rotations(pose, &offsets);
+        let local = rig.local_rotations(pose);
         let mut line = format!("{:.6} {:.6} {:.6}", pose[0][0], pose[0][1], pose[0][2]);
         for &j in &order {
-            let local = match PARENTS[j] {
-                None => g[j],
-                Some(p) => g[p].inv().mul(g[j]),
-            };
-            let [z, y, x] = euler_zyx_degrees(local);
+            let [z, y, x] = euler_zyx_degrees(local[j]);
             let _ = write!(line, " {z:.6} {y:.6} {x:.6}");
         }
         out.push_str(&line);

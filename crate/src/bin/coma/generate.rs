@@ -17,7 +17,7 @@ pub struct GenerateArgs {
     /// A body part's own instruction, e.g. --part "left arm=waves the left hand".
     #[arg(long = "part")]
     parts: Vec<String>,
-    /// Motion file to write (.bvh, .npy features, .json joints).
+    /// Motion file to write (.bvh, .npy features, .json joints, .glb skinned figure).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Filmstrip PNG to write.

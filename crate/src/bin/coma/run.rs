@@ -21,7 +21,7 @@ pub struct RunArgs {
     rounds: usize,
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Motion files to write (.bvh, .json or .npy features); may repeat.
+    /// Motion files to write (.bvh, .json, .glb or .npy features); may repeat.
     #[arg(long)]
     out: Vec<PathBuf>,
     /// Filmstrip PNG of the result.
