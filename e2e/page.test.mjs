@@ -11,7 +11,10 @@
 // a real local LLM server from the page (fetch from the page's worker, CORS), when
 // COMA_LOCAL_LLM names one (scripts/test.sh starts it with scripts/llm_server.sh). The last
 // two time a 196-frame motion without review (cold, then warm) and a repeat visit in a
-// persistent profile, and print the figures.
+// persistent profile, and print the figures. After them, in Chromium without WebGPU, the 3D view
+// draws the shaded figure with WebGL2 and, asked with ?renderer=2d, with Canvas 2D (limb-coloured
+// pixels around the root's picture position, the renderer named, the frame time printed, a lost
+// WebGL2 context falling to Canvas 2D), and a link's prompt, length and seed fill the prompt box.
 //
 // Needs: the built page in DIST (default ../dist), the coma binary in COMA (serves the page and
 // reads the BVH), /usr/bin/chromium.
@@ -798,6 +801,12 @@ test("the 3D view draws a shaded figure with WebGL2 or Canvas 2D where there is 
     const shown = [];
     const gl = await still(first.page, join(FIGURES, "figure-webgl2.png"));
     shown.push(["WebGL2", gl]);
+    // A lost WebGL2 context: the view falls to Canvas 2D and the status line says why.
+    await first.page.evaluate(() => document.querySelector("#view").getContext("webgl2")
+      .getExtension("WEBGL_lose_context").loseContext());
+    await first.page.waitForFunction(() => document.querySelector(".viewer")?.dataset.renderer === "2d");
+    assert.match(await first.page.locator("#status").textContent(), /WebGL2 renderer stopped \(the WebGL2 context was lost\)/);
+    assert.equal(await first.page.locator("#view-renderer").textContent(), "View: Canvas 2D");
 
     // The same motion's link, with the 2D renderer asked for: the prompt box shows the link's
     // prompt, length and seed, and the view draws with Canvas 2D.

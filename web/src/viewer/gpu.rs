@@ -11,6 +11,8 @@ use super::scene::{
     VERTEX_BYTES,
 };
 use std::sync::{Arc, Mutex};
+use wasm_bindgen::closure::Closure;
+use wasm_bindgen::JsCast;
 
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The uniform: a 4×4 matrix and two vec4s.
@@ -101,6 +103,22 @@ impl GpuRenderer {
             ..wgpu::InstanceDescriptor::new_without_display_handle()
         });
         let name = api.name();
+        let failure = Arc::new(Mutex::new(None));
+        if api == GpuApi::WebGl2 {
+            // wgpu does not report a lost WebGL context as a lost device; the canvas does.
+            let lost = failure.clone();
+            let listener = Closure::<dyn FnMut()>::new(move || {
+                keep_first(&lost, "the WebGL2 context was lost".into());
+            });
+            canvas
+                .add_event_listener_with_callback(
+                    "webglcontextlost",
+                    listener.as_ref().unchecked_ref(),
+                )
+                .map_err(|e| format!("cannot watch the canvas's WebGL2 context: {e:?}"))?;
+            // Lives as long as the canvas, which the next renderer replaces.
+            listener.forget();
+        }
         let surface = instance
             .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
             .map_err(|e| format!("the canvas cannot show {name}: {e}"))?;
@@ -121,7 +139,6 @@ impl GpuRenderer {
             })
             .await
             .map_err(|e| format!("no {name} device: {e}"))?;
-        let failure = Arc::new(Mutex::new(None));
         let lost = failure.clone();
         device.set_device_lost_callback(move |reason, message| {
             keep_first(
