@@ -10,7 +10,8 @@ use super::scene::Frame;
 
 /// The renderer that draws the view.
 pub enum Renderer {
-    Gpu(GpuRenderer, RendererKind),
+    /// Boxed: the wgpu renderer is large, and the enum is moved around while it starts.
+    Gpu(Box<GpuRenderer>, RendererKind),
     Canvas2d(Canvas2dRenderer),
 }
 
@@ -23,10 +24,10 @@ impl Renderer {
         match kind {
             RendererKind::WebGpu => GpuRenderer::new(canvas, GpuApi::WebGpu)
                 .await
-                .map(|r| Renderer::Gpu(r, kind)),
+                .map(|r| Renderer::Gpu(Box::new(r), kind)),
             RendererKind::WebGl2 => GpuRenderer::new(canvas, GpuApi::WebGl2)
                 .await
-                .map(|r| Renderer::Gpu(r, kind)),
+                .map(|r| Renderer::Gpu(Box::new(r), kind)),
             RendererKind::Canvas2d => Canvas2dRenderer::new(canvas).map(Renderer::Canvas2d),
         }
     }
