@@ -699,7 +699,7 @@ mod tests {
         let towards = shade(LIGHT);
         let away = shade(scale(LIGHT, -1.0));
         assert!((towards - (AMBIENT + SKY * (0.5 + 0.5 * LIGHT[1]) + DIFFUSE)).abs() < 1e-5);
-        assert!(away < 0.45 && away >= AMBIENT, "{away}");
+        assert!((AMBIENT..0.45).contains(&away), "{away}");
         assert!(shade([0.0, 1.0, 0.0]) > shade([0.0, -1.0, 0.0]));
         // Lengths do not matter, only directions.
         assert!((shade([0.0, 0.0, 3.0]) - shade([0.0, 0.0, 1.0])).abs() < 1e-6);
