@@ -14,9 +14,8 @@
 //! Units are metres in the pose's own frame (the product's: Y up, facing +Z, left is +X).
 //! Triangles wind counter-clockwise seen from outside (glTF's and wgpu's default front face).
 
+use crate::geom::{add, cross, dot, norm, scale, sub, Vec3};
 use crate::skeleton::{joint, NUM_JOINTS};
-
-type V3 = [f32; 3];
 
 /// Vertices around every ring of a part.
 const SIDES: usize = 12;
@@ -52,45 +51,23 @@ struct Part {
     /// The joint that carries it.
     joint: usize,
     /// Axis ends (metres): the caps' centres.
-    a: V3,
-    b: V3,
+    a: Vec3,
+    b: Vec3,
     /// Radii of the caps at `a` and `b` (metres), along the axis.
-    ra: f32,
-    rb: f32,
+    ra: f64,
+    rb: f64,
     /// Direction of the cross-section's first semi-axis (made perpendicular to the axis).
-    side: V3,
+    side: Vec3,
     /// Cross-section scale along `side` and along axis × side (1, 1: round).
-    aspect: [f32; 2],
+    aspect: [f64; 2],
 }
 
 /// Most triangles a figure has (the parts are fixed: 26 capsules).
 pub const MAX_TRIANGLES: usize = 26 * PART_TRIANGLES;
 
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(a: V3, s: f32) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn length(a: V3) -> f32 {
-    dot(a, a).sqrt()
-}
 /// `a` scaled to unit length, or `fallback` when `a` is (nearly) zero.
-fn unit_or(a: V3, fallback: V3) -> V3 {
-    let n = length(a);
+fn unit_or(a: Vec3, fallback: Vec3) -> Vec3 {
+    let n = norm(a);
     if n > 1e-6 {
         scale(a, 1.0 / n)
     } else {
@@ -102,6 +79,7 @@ fn unit_or(a: V3, fallback: V3) -> V3 {
 /// skeleton's size (1.7 m or so).
 fn parts(pose: &[[f32; 3]; NUM_JOINTS]) -> Vec<Part> {
     use joint::*;
+    let pose = pose.map(|v| v.map(f64::from));
     let p = |j: usize| pose[j];
     // Left-right directions of the hips and shoulders: the flat sides of the torso, head and
     // feet face them.
@@ -109,7 +87,7 @@ fn parts(pose: &[[f32; 3]; NUM_JOINTS]) -> Vec<Part> {
     let shoulders = sub(p(L_COLLAR), p(R_COLLAR));
     let round = [1.0, 1.0];
     let flat = [1.3, 0.8];
-    let bone = |j: usize, from: usize, to: usize, ra: f32, rb: f32, side: V3, aspect| Part {
+    let bone = |j: usize, from: usize, to: usize, ra: f64, rb: f64, side: Vec3, aspect| Part {
         joint: j,
         a: p(from),
         b: p(to),
@@ -120,7 +98,7 @@ fn parts(pose: &[[f32; 3]; NUM_JOINTS]) -> Vec<Part> {
     };
     // A part that starts at joint `from` and runs `len` metres past it along the bone
     // `back`→`from` (hands beyond the wrists, toes beyond the foot joints).
-    let beyond = |from: usize, back: usize, start: f32, len: f32| {
+    let beyond = |from: usize, back: usize, start: f64, len: f64| {
         let d = unit_or(sub(p(from), p(back)), [0.0, -1.0, 0.0]);
         (add(p(from), scale(d, start)), add(p(from), scale(d, len)))
     };
@@ -193,7 +171,7 @@ fn push_part(mesh: &mut FigureMesh, part: &Part) {
     // A part shorter than the difference of its radii (a wrist inside its elbow) would turn
     // its tube inside out: it becomes a ball of the larger radius.
     let mut part = *part;
-    if length(sub(part.b, part.a)) < (part.ra - part.rb).abs() {
+    if norm(sub(part.b, part.a)) < (part.ra - part.rb).abs() {
         part.ra = part.ra.max(part.rb);
         part.rb = part.ra;
     }
@@ -202,7 +180,7 @@ fn push_part(mesh: &mut FigureMesh, part: &Part) {
     // least aligned with it keeps the mesh defined and deterministic.
     let side = {
         let s = sub(part.side, scale(d, dot(part.side, d)));
-        if length(s) > 1e-4 * length(part.side).max(1e-6) && length(s) > 1e-7 {
+        if norm(s) > 1e-4 * norm(part.side).max(1e-6) && norm(s) > 1e-7 {
             unit_or(s, [1.0, 0.0, 0.0])
         } else {
             let e = if d[0].abs() < 0.6 {
@@ -217,24 +195,24 @@ fn push_part(mesh: &mut FigureMesh, part: &Part) {
     let [sx, sw] = part.aspect;
     let base = mesh.positions.len() as u32;
     let joint = part.joint as u8;
-    let mut push = |position: V3, normal: V3| {
-        mesh.positions.push(position);
-        mesh.normals.push(unit_or(normal, d));
+    let mut push = |position: Vec3, normal: Vec3| {
+        mesh.positions.push(position.map(|v| v as f32));
+        mesh.normals.push(unit_or(normal, d).map(|v| v as f32));
         mesh.joints.push(joint);
     };
     // Pole at `a`, the rings of cap a (pole to equator), of cap b (equator to pole), pole at b.
     push(sub(part.a, scale(d, part.ra)), scale(d, -1.0));
-    let rings: Vec<(V3, f32, f32, f32)> = (1..=CAP_RINGS)
+    let rings: Vec<(Vec3, f64, f64, f64)> = (1..=CAP_RINGS)
         .map(|i| (part.a, part.ra, -1.0, i))
         .chain((1..=CAP_RINGS).rev().map(|i| (part.b, part.rb, 1.0, i)))
         .map(|(c, r, sign, i)| {
-            let phi = std::f32::consts::FRAC_PI_2 * i as f32 / CAP_RINGS as f32;
+            let phi = std::f64::consts::FRAC_PI_2 * i as f64 / CAP_RINGS as f64;
             (c, r, sign * phi.cos(), phi.sin())
         })
         .collect();
     for &(c, r, along, around) in &rings {
         for k in 0..SIDES {
-            let theta = std::f32::consts::TAU * k as f32 / SIDES as f32;
+            let theta = std::f64::consts::TAU * k as f64 / SIDES as f64;
             let (sin, cos) = theta.sin_cos();
             let radial = add(scale(side, sx * cos), scale(w, sw * sin));
             let position = add(add(c, scale(d, r * along)), scale(radial, r * around));
@@ -287,40 +265,53 @@ pub fn figure_mesh(pose: &[[f32; 3]; NUM_JOINTS]) -> FigureMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::skeleton::{Offsets, PARENTS};
+    use crate::skeleton::{Offsets, Pose, PARENTS};
 
     /// The reference skeleton standing, pelvis 0.93 m up.
     fn rest_pose() -> [[f32; 3]; NUM_JOINTS] {
+        as_f32(&rest_pose_f64())
+    }
+
+    fn rest_pose_f64() -> Pose {
         let offsets = Offsets::reference().0;
         let mut pose = [[0.0f64; 3]; NUM_JOINTS];
         pose[0] = [0.0, 0.93, 0.0];
         for j in 1..NUM_JOINTS {
             let p = PARENTS[j].unwrap();
-            pose[j] = crate::geom::add(pose[p], offsets[j]);
+            pose[j] = add(pose[p], offsets[j]);
         }
         // The head up, as people stand (the reference skeleton's head bone points forward).
-        pose[joint::HEAD] = crate::geom::add(pose[joint::NECK], [0.0, 0.103, 0.0]);
+        pose[joint::HEAD] = add(pose[joint::NECK], [0.0, 0.103, 0.0]);
+        pose
+    }
+
+    fn as_f32(pose: &Pose) -> [[f32; 3]; NUM_JOINTS] {
         pose.map(|v| v.map(|x| x as f32))
+    }
+
+    /// Vertex positions or normals in f64.
+    fn f64s(v: &[[f32; 3]]) -> Vec<Vec3> {
+        v.iter().map(|p| p.map(f64::from)).collect()
     }
 
     /// A pose with bent limbs, a leaning trunk and the wrists inside the elbows (a
     /// zero-length forearm, to check degenerate bones).
     fn bent_pose() -> [[f32; 3]; NUM_JOINTS] {
-        let mut pose = rest_pose();
+        let mut pose = rest_pose_f64();
         pose[joint::L_ELBOW] = add(pose[joint::L_SHOULDER], [0.2, 0.1, 0.1]);
         pose[joint::L_WRIST] = add(pose[joint::L_ELBOW], [0.0, 0.25, 0.05]);
         pose[joint::R_WRIST] = pose[joint::R_ELBOW];
         pose[joint::L_ANKLE] = add(pose[joint::L_KNEE], [0.0, -0.2, -0.35]);
         pose[joint::HEAD] = add(pose[joint::NECK], [0.0, 0.05, 0.09]);
-        pose
+        as_f32(&pose)
     }
 
     /// The largest distance of a part's surface from its axis segment (metres).
-    fn max_radius(part: &Part) -> f32 {
+    fn max_radius(part: &Part) -> f64 {
         part.ra.max(part.rb) * part.aspect[0].max(part.aspect[1]).max(1.0)
     }
 
-    fn distance_to_segment(p: V3, a: V3, b: V3) -> (f32, V3) {
+    fn distance_to_segment(p: Vec3, a: Vec3, b: Vec3) -> (f64, Vec3) {
         let ab = sub(b, a);
         let t = if dot(ab, ab) > 0.0 {
             (dot(sub(p, a), ab) / dot(ab, ab)).clamp(0.0, 1.0)
@@ -328,7 +319,7 @@ mod tests {
             0.0
         };
         let q = add(a, scale(ab, t));
-        (length(sub(p, q)), q)
+        (norm(sub(p, q)), q)
     }
 
     /// The part each vertex belongs to (parts are laid out one after another).
@@ -336,7 +327,7 @@ mod tests {
         let per_part = 2 + 2 * CAP_RINGS * SIDES;
         parts(pose)
             .into_iter()
-            .flat_map(|p| std::iter::repeat(p).take(per_part))
+            .flat_map(|p| std::iter::repeat_n(p, per_part))
             .collect()
     }
 
@@ -378,8 +369,9 @@ mod tests {
             let mesh = figure_mesh(&pose);
             let owners = part_of_vertices(&pose);
             assert_eq!(owners.len(), mesh.positions.len());
-            for ((p, n), part) in mesh.positions.iter().zip(&mesh.normals).zip(&owners) {
-                assert!((length(*n) - 1.0).abs() < 1e-5);
+            let (positions, normals) = (f64s(&mesh.positions), f64s(&mesh.normals));
+            for ((p, n), part) in positions.iter().zip(&normals).zip(&owners) {
+                assert!((norm(*n) - 1.0).abs() < 1e-5);
                 let (_, q) = distance_to_segment(*p, part.a, part.b);
                 assert!(
                     dot(*n, sub(*p, q)) > 0.0,
@@ -389,15 +381,13 @@ mod tests {
             }
             // Winding: each triangle's face normal agrees with its corners' normals.
             for t in mesh.indices.chunks(3) {
-                let [a, b, c] = [0, 1, 2].map(|i| mesh.positions[t[i] as usize]);
+                let [a, b, c] = [0, 1, 2].map(|i| positions[t[i] as usize]);
                 let face = cross(sub(b, a), sub(c, a));
-                if length(face) < 1e-9 {
+                if norm(face) < 1e-9 {
                     // The tube of a zero-length bone: no area, nothing to see.
                     continue;
                 }
-                let normal = t
-                    .iter()
-                    .fold([0.0; 3], |s, &i| add(s, mesh.normals[i as usize]));
+                let normal = t.iter().fold([0.0; 3], |s, &i| add(s, normals[i as usize]));
                 assert!(dot(face, normal) > 0.0, "triangle {t:?} winds inward");
             }
         }
@@ -407,14 +397,14 @@ mod tests {
     fn vertices_stay_within_their_capsule() {
         let pose = bent_pose();
         let mesh = figure_mesh(&pose);
-        for (p, part) in mesh.positions.iter().zip(part_of_vertices(&pose)) {
+        for (p, part) in f64s(&mesh.positions).iter().zip(part_of_vertices(&pose)) {
             let (dist, _) = distance_to_segment(*p, part.a, part.b);
             assert!(dist <= max_radius(&part) + 1e-5, "{dist} from the axis");
             assert!(max_radius(&part) <= 0.16);
         }
         // Each bone part's axis is the bone itself: the joint's own position starts it.
         for part in parts(&pose) {
-            let start = pose[part.joint];
+            let start = pose[part.joint].map(f64::from);
             let (dist, _) = distance_to_segment(start, part.a, part.b);
             assert!(dist < 0.1, "joint {} is {dist} m from its part", part.joint);
         }
@@ -422,18 +412,19 @@ mod tests {
 
     #[test]
     fn mesh_follows_the_pose() {
-        let pose = rest_pose();
-        let before = figure_mesh(&pose);
-        assert_eq!(before, figure_mesh(&pose), "deterministic");
+        let pose = rest_pose_f64();
+        let before = figure_mesh(&as_f32(&pose));
+        assert_eq!(before, figure_mesh(&as_f32(&pose)), "deterministic");
         // Bend the left knee: the shin and the foot move, nothing else does.
         let mut bent = pose;
         let shift = [0.0, 0.1, -0.2];
         for j in [joint::L_ANKLE, joint::L_FOOT] {
             bent[j] = add(bent[j], shift);
         }
-        let after = figure_mesh(&bent);
-        let moved: Vec<u8> = (0..before.positions.len())
-            .filter(|&i| length(sub(before.positions[i], after.positions[i])) > 1e-6)
+        let after = f64s(&figure_mesh(&as_f32(&bent)).positions);
+        let positions = f64s(&before.positions);
+        let moved: Vec<u8> = (0..positions.len())
+            .filter(|&i| norm(sub(positions[i], after[i])) > 1e-6)
             .map(|i| before.joints[i])
             .collect();
         for j in [joint::L_KNEE, joint::L_ANKLE, joint::L_FOOT] {
@@ -444,9 +435,9 @@ mod tests {
             .all(|&j| [joint::L_KNEE, joint::L_ANKLE, joint::L_FOOT].contains(&(j as usize))));
         // A whole-body translation moves every vertex by the same amount.
         let moved_pose = pose.map(|v| add(v, [1.0, 0.0, -2.0]));
-        let shifted = figure_mesh(&moved_pose);
-        for (a, b) in before.positions.iter().zip(&shifted.positions) {
-            assert!(length(sub(add(*a, [1.0, 0.0, -2.0]), *b)) < 1e-5);
+        let shifted = figure_mesh(&as_f32(&moved_pose));
+        for (a, b) in positions.iter().zip(&f64s(&shifted.positions)) {
+            assert!(norm(sub(add(*a, [1.0, 0.0, -2.0]), *b)) < 1e-5);
         }
         assert_eq!(before.normals.len(), shifted.normals.len());
     }
