@@ -96,9 +96,9 @@ fn tick(
         camera.follow([pose[0][0], pose[0][2]], (dt * 3.0).min(1.0) as f32);
     }
     let mut lines = grid_lines([camera.target[0], camera.target[2]], 3.0, 0.5);
-    let (mut body, mut shadows) = (Vec::new(), Vec::new());
+    let (mut body, mut parts, mut shadows) = (Vec::new(), Vec::new(), Vec::new());
     if let Some(pose) = &pose {
-        body = body_triangles(pose, settings.skeleton.get_untracked(), &camera);
+        (body, parts) = body_triangles(pose, settings.skeleton.get_untracked(), &camera);
         shadows = contact_shadows(pose);
         state.history.with_untracked(|h| {
             if let Some(take) = h.current() {
@@ -117,6 +117,7 @@ fn tick(
         lines: &lines,
         shadows: &shadows,
         body: &body,
+        body_parts: &parts,
     })?;
     // How many frames reached the screen, for tests and for telling a stuck canvas.
     let count: u64 = canvas

@@ -2,7 +2,7 @@
 //! fills what [`super::flat`] computes (the same triangles, camera and light as the GPU
 //! renderers, sorted back to front and flat-shaded per triangle) and strokes the lines.
 
-use super::flat::{flat_lines, flat_triangles, shadow_rings};
+use super::flat::{flat_lines, flat_parts, shadow_rings};
 use super::scene::{Frame, BACKGROUND};
 use wasm_bindgen::JsCast;
 
@@ -69,11 +69,11 @@ impl Canvas2dRenderer {
             }
         }
 
-        // The figure, back to front. Each triangle is also outlined in its own colour: the
+        // The figure, back to front, part by part. Each triangle is also outlined in its own colour: the
         // canvas smooths every edge, which otherwise leaves light seams between neighbours.
         ctx.set_line_width(0.8);
         ctx.set_line_join("round");
-        for t in flat_triangles(frame.body, m, frame.eye, size) {
+        for t in flat_parts(frame.body, frame.body_parts, m, frame.eye, size) {
             let color = css_rgb(t.rgb);
             ctx.set_global_alpha(t.alpha as f64);
             ctx.begin_path();

@@ -36,8 +36,27 @@ fn to_u8(c: f32) -> u8 {
 /// it is lit (non-zero normals) and its mean normal faces away from the camera at `eye`;
 /// its colour is the corners' mean colour times [`shade`] of their mean normal.
 pub fn flat_triangles(vertices: &[Vertex], m: &Mat4, eye: V3, size: [f32; 2]) -> Vec<FlatTriangle> {
+    flat_parts(vertices, &[], m, eye, size)
+}
+
+/// [`flat_triangles`] of a body made of parts (`parts`: one number per triangle, the same for
+/// the triangles of one closed part, such as one capsule of the figure): whole parts are
+/// painted back to front by the mean depth of their visible triangles, and each part's
+/// triangles back to front within it. Parts that pass into each other (a thigh into the
+/// pelvis) then paint as wholes, instead of the inner triangles of one showing through the
+/// other where a triangle-by-triangle sort misorders them. With fewer numbers than triangles,
+/// each triangle is its own part.
+pub fn flat_parts(
+    vertices: &[Vertex],
+    parts: &[u16],
+    m: &Mat4,
+    eye: V3,
+    size: [f32; 2],
+) -> Vec<FlatTriangle> {
+    let grouped = parts.len() == vertices.len() / 3;
     let mut out = Vec::with_capacity(vertices.len() / 3);
-    for tri in vertices.chunks_exact(3) {
+    let mut part_of = Vec::with_capacity(vertices.len() / 3);
+    for (i, tri) in vertices.chunks_exact(3).enumerate() {
         let normal = sum(tri.iter().map(|v| v.normal));
         if normal != [0.0, 0.0, 0.0] {
             let centre = scale(sum(tri.iter().map(|v| v.position)), 1.0 / 3.0);
@@ -61,6 +80,7 @@ pub fn flat_triangles(vertices: &[Vertex], m: &Mat4, eye: V3, size: [f32; 2]) ->
         if !visible {
             continue;
         }
+        part_of.push(if grouped { Some(parts[i]) } else { None });
         let k = shade(normal);
         let color: [f32; 4] =
             std::array::from_fn(|i| tri.iter().map(|v| v.color[i]).sum::<f32>() / 3.0);
@@ -75,10 +95,28 @@ pub fn flat_triangles(vertices: &[Vertex], m: &Mat4, eye: V3, size: [f32; 2]) ->
             alpha: color[3].clamp(0.0, 1.0),
         });
     }
-    // Far first, so nearer triangles paint over them. total_cmp: no NaN reaches here (the
-    // corners are finite), and it keeps the sort from panicking if one did.
-    out.sort_by(|a, b| b.depth.total_cmp(&a.depth));
-    out
+    // Each triangle's sort key: its part's mean depth (its own without parts), then its own.
+    let mut sums = std::collections::HashMap::<u16, (f32, u32)>::new();
+    for (t, part) in out.iter().zip(&part_of) {
+        if let Some(p) = part {
+            let e = sums.entry(*p).or_insert((0.0, 0));
+            *e = (e.0 + t.depth, e.1 + 1);
+        }
+    }
+    let mut keyed: Vec<(f32, FlatTriangle)> = out
+        .into_iter()
+        .zip(part_of)
+        .map(|(t, part)| {
+            let key = part
+                .and_then(|p| sums.get(&p))
+                .map_or(t.depth, |(sum, n)| sum / *n as f32);
+            (key, t)
+        })
+        .collect();
+    // Far first, so nearer ones paint over them. total_cmp: no NaN reaches here (the corners
+    // are finite), and it keeps the sort from panicking if one did.
+    keyed.sort_by(|a, b| b.0.total_cmp(&a.0).then(b.1.depth.total_cmp(&a.1.depth)));
+    keyed.into_iter().map(|(_, t)| t).collect()
 }
 
 /// The segments of `vertices` (a line list) as the picture shows them; a segment that passes
@@ -278,5 +316,40 @@ mod tests {
         // Each ring is inside the one before it: its leftmost point is further right.
         let left = |o: &Vec<[f32; 2]>| o.iter().map(|p| p[0]).fold(f32::INFINITY, f32::min);
         assert!(rings.windows(2).all(|w| left(&w[1].0) > left(&w[0].0)));
+    }
+
+    #[test]
+    fn whole_parts_paint_back_to_front() {
+        let camera = OrbitCamera {
+            yaw: 0.0,
+            pitch: 0.0,
+            ..OrbitCamera::default()
+        };
+        let m = camera.view_projection(1.0);
+        let t = camera.target;
+        let tri = |z: f32| {
+            [[-0.1, -0.1, z], [0.1, -0.1, z], [0.0, 0.1, z]]
+                .map(|d| lit([t[0] + d[0], t[1] + d[1], t[2] + d[2]], UNLIT))
+        };
+        // Part 0: triangles at z = 0 and z = 0.6 (mean 0.3); part 1: one at z = 0.4, whose own
+        // depth lies between part 0's two.
+        let vertices: Vec<Vertex> = [tri(0.0), tri(0.6), tri(0.4)].concat();
+        let eye = camera.eye();
+        let by_triangle = flat_triangles(&vertices, &m, eye, [100.0, 100.0]);
+        let by_part = flat_parts(&vertices, &[0, 0, 1], &m, eye, [100.0, 100.0]);
+        let order = |f: &[FlatTriangle]| f.iter().map(|t| t.depth).collect::<Vec<_>>();
+        let d = |z: f32| camera.distance - z;
+        let close = |a: Vec<f32>, b: [f32; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-3);
+        assert!(close(order(&by_triangle), [d(0.0), d(0.4), d(0.6)]));
+        // Part 0 (further on average) first, whole, far to near; then part 1.
+        assert!(
+            close(order(&by_part), [d(0.0), d(0.6), d(0.4)]),
+            "{by_part:?}"
+        );
+        // Parts that do not match the triangles are ignored.
+        assert_eq!(
+            flat_parts(&vertices, &[0], &m, eye, [100.0, 100.0]),
+            by_triangle
+        );
     }
 }

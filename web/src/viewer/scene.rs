@@ -257,6 +257,9 @@ pub struct Frame<'a> {
     pub lines: &'a [Vertex],
     pub shadows: &'a [Shadow],
     pub body: &'a [Vertex],
+    /// The part of each body triangle (see [`figure`]) for the 2D renderer's sort; empty when
+    /// the body has no parts.
+    pub body_parts: &'a [u16],
 }
 
 /// The normal of what is not lit.
@@ -363,6 +366,12 @@ fn is_limb_color(c: [u8; 3]) -> bool {
 /// joint belongs to. Triangles with a corner that is not a number (from joints that are not)
 /// are left out.
 pub fn figure_triangles(pose: &[V3; 22]) -> Vec<Vertex> {
+    figure(pose).0
+}
+
+/// [`figure_triangles`] with the part of each triangle: the figure's capsules are laid out one
+/// after another, each carried by one joint, so a new part starts wherever the joint changes.
+pub fn figure(pose: &[V3; 22]) -> (Vec<Vertex>, Vec<u16>) {
     let mesh = coma::figure::figure_mesh(pose);
     let vertex = |i: u32| {
         let i = i as usize;
@@ -383,21 +392,34 @@ pub fn figure_triangles(pose: &[V3; 22]) -> Vec<Vertex> {
             })
     };
     let mut out = Vec::with_capacity(mesh.indices.len());
+    let mut parts = Vec::with_capacity(mesh.indices.len() / 3);
+    let (mut part, mut joint) = (0u16, None);
     for tri in mesh.indices.chunks_exact(3) {
+        let carrier = mesh.joints.get(tri[0] as usize).copied();
+        if joint.is_some() && carrier != joint {
+            part = part.saturating_add(1);
+        }
+        joint = carrier;
         if let (Some(a), Some(b), Some(c)) = (vertex(tri[0]), vertex(tri[1]), vertex(tri[2])) {
             out.extend([a, b, c]);
+            parts.push(part);
         }
     }
-    out
+    (out, parts)
 }
 
-/// The figure of one pose as the view shows it: the shaded body, or with `skeleton` the
-/// skeleton's ribbons and squares (unlit, turned to `camera`).
-pub fn body_triangles(pose: &[V3; 22], skeleton: bool, camera: &OrbitCamera) -> Vec<Vertex> {
+/// The figure of one pose as the view shows it: the shaded body with the part of each
+/// triangle ([`figure`]), or with `skeleton` the skeleton's ribbons and squares (unlit, turned
+/// to `camera`; no parts).
+pub fn body_triangles(
+    pose: &[V3; 22],
+    skeleton: bool,
+    camera: &OrbitCamera,
+) -> (Vec<Vertex>, Vec<u16>) {
     if skeleton {
-        skeleton_triangles(pose, camera)
+        (skeleton_triangles(pose, camera), Vec::new())
     } else {
-        figure_triangles(pose)
+        figure(pose)
     }
 }
 
@@ -814,10 +836,15 @@ mod tests {
         assert!(torso[0] > 0.5 && torso[0] < 0.65, "{torso:?}");
         // The skeleton toggle: unlit ribbons instead.
         let camera = OrbitCamera::default();
-        assert!(body_triangles(&pose, true, &camera)
-            .iter()
-            .all(|v| v.normal == UNLIT));
-        assert_eq!(body_triangles(&pose, false, &camera), body);
+        let (sticks, no_parts) = body_triangles(&pose, true, &camera);
+        assert!(sticks.iter().all(|v| v.normal == UNLIT) && no_parts.is_empty());
+        let (shaded, parts) = body_triangles(&pose, false, &camera);
+        assert_eq!(shaded, body);
+        // One part per capsule of the mesh, numbered in order.
+        assert_eq!(parts.len(), body.len() / 3);
+        assert_eq!(parts.first(), Some(&0));
+        assert!(parts.windows(2).all(|w| w[1] == w[0] || w[1] == w[0] + 1));
+        assert!(*parts.last().unwrap() >= 20, "{:?}", parts.last());
     }
 
     #[test]
