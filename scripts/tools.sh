@@ -19,14 +19,15 @@ ensure_wasm_test_runner() {
   fi
 }
 
-# Debian's Chromium and its driver, and Playwright's driver library (no browser download):
-# what the browser tests need.
+# Debian's Chromium and its driver, and Playwright's driver library (no browser download) with
+# pngjs: what the browser tests need.
 ensure_browser_tools() {
   if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
     echo "installing chromium and chromium-driver (once)"
     apt-get update -q && apt-get install -y -q chromium chromium-driver
   fi
-  if [ ! -d e2e/node_modules/playwright-core ]; then
+  # pngjs: the figure test decodes the canvas's screenshots.
+  if [ ! -d e2e/node_modules/playwright-core ] || [ ! -d e2e/node_modules/pngjs ]; then
     (cd e2e && npm install --no-audit --no-fund)
   fi
 }
