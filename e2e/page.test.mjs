@@ -11,17 +11,21 @@
 // a real local LLM server from the page (fetch from the page's worker, CORS), when
 // COMA_LOCAL_LLM names one (scripts/test.sh starts it with scripts/llm_server.sh). The last
 // two time a 196-frame motion without review (cold, then warm) and a repeat visit in a
-// persistent profile, and print the figures.
+// persistent profile, and print the figures. After them, in Chromium without WebGPU, the 3D view
+// draws the shaded figure with WebGL2 and, asked with ?renderer=2d, with Canvas 2D (limb-coloured
+// pixels around the root's picture position, the renderer named, the frame time printed, a lost
+// WebGL2 context falling to Canvas 2D), and a link's prompt, length and seed fill the prompt box.
 //
 // Needs: the built page in DIST (default ../dist), the coma binary in COMA (serves the page and
 // reads the BVH), /usr/bin/chromium.
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import { spawn, execFileSync } from "node:child_process";
-import { existsSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { homedir, tmpdir } from "node:os";
 import { join, resolve } from "node:path";
 import { chromium } from "playwright-core";
+import { PNG } from "pngjs";
 import {
   ARGS, PLAIN_ARGS, LOAD_TIMEOUT, modelLoaded, jointsHash, fillPrompt, generateNew, timeGenerations,
 } from "./page_driver.mjs";
@@ -351,6 +355,7 @@ test("a share link pasted into a tab that already shows the page opens there", {
     await paste(page, a.fragment);
     await shows(page, a.hash);
     console.log(`a pasted link opened in the tab in ${((Date.now() - started) / 1000).toFixed(1)} s`);
+    assert.equal(await page.inputValue("#seed"), "1", "the prompt box shows the pasted link's seed");
     let said = await statuses(page);
     assert.ok(said.some((l) => /opening the shared motion/.test(l)), said.join(" | "));
     assert.match(await page.locator("#status").textContent(), /^Done/);
@@ -723,6 +728,131 @@ test("a repeat visit in a persistent browser profile, bytes and time until inter
       `repeat visit: ${(again.bytes / 1e6).toFixed(3)} MB, interactive in ${again.seconds.toFixed(1)} s`);
     assert.ok(again.bytes < first.bytes / 10, `the repeat visit downloaded ${again.bytes} bytes again`);
   } finally {
+    await stop(server);
+  }
+});
+
+/** Pixels of the figure's limbs in a PNG screenshot of the canvas within `radius` pixels of
+ * `[x, y]`: per limb colour (the tints of coma's PART_COLORS, crate/src/render/mod.rs, as
+ * web/src/viewer/scene.rs's `tint` lightens them), how many pixels have that hue and are
+ * saturated, which the background (0.93, 0.945, 0.965), the grey grid, the shadows and the
+ * grey torso are not. */
+function limbPixels(png, [x, y], radius) {
+  const tints = {
+    "left arm": [238, 128, 16], "right arm": [36, 104, 214], "left leg": [206, 30, 52], "right leg": [30, 150, 70],
+  };
+  const hue = (r, g, b) => {
+    const max = Math.max(r, g, b), d = max - Math.min(r, g, b);
+    if (d === 0) return null;
+    const h = max === r ? ((g - b) / d + 6) % 6 : max === g ? (b - r) / d + 2 : (r - g) / d + 4;
+    return h * 60;
+  };
+  const hues = Object.fromEntries(Object.entries(tints).map(([part, c]) =>
+    [part, hue(...c.map((v, i) => v * 0.8 + [245, 240, 232][i] * 0.2))]));
+  const counts = Object.fromEntries(Object.keys(tints).map((p) => [p, 0]));
+  for (let py = Math.max(0, Math.floor(y - radius)); py < Math.min(png.height, y + radius); py++) {
+    for (let px = Math.max(0, Math.floor(x - radius)); px < Math.min(png.width, x + radius); px++) {
+      if ((px - x) ** 2 + (py - y) ** 2 > radius ** 2) continue;
+      const i = (py * png.width + px) * 4;
+      const [r, g, b] = [png.data[i], png.data[i + 1], png.data[i + 2]];
+      const max = Math.max(r, g, b);
+      if (max === 0 || (max - Math.min(r, g, b)) / max < 0.35) continue;
+      const h = hue(r, g, b);
+      for (const [part, th] of Object.entries(hues)) {
+        if (Math.min(Math.abs(h - th), 360 - Math.abs(h - th)) < 12) counts[part]++;
+      }
+    }
+  }
+  return counts;
+}
+
+/** Pauses the page's playback, lets the camera settle, and returns what the canvas shows:
+ * the renderer, the root's picture position, the frame time and the decoded screenshot. */
+async function still(page, shot) {
+  // The running mean of the frame time while the motion plays.
+  const frameMs = Number(await page.locator("#view").getAttribute("data-frame-ms"));
+  if ((await page.locator("#play").textContent()) === "Pause") await page.click("#play");
+  await page.waitForTimeout(1500);
+  const root = (await page.locator("#view").getAttribute("data-root-px")).split(",").map(Number);
+  const bytes = await page.locator("#view").screenshot({ path: shot });
+  return {
+    renderer: await page.locator(".viewer").getAttribute("data-renderer"),
+    status: await page.locator("#view-renderer").textContent(),
+    root, frameMs, png: PNG.sync.read(bytes),
+  };
+}
+
+/** Where the figure's screenshots go (docs/screenshots by default). */
+const FIGURES = join(SHOTS, "screenshots");
+
+test("the 3D view draws a shaded figure with WebGL2 or Canvas 2D where there is no WebGPU", { timeout: 30 * 60_000 }, async () => {
+  const server = serve();
+  const plain = await chromium.launch({ executablePath: "/usr/bin/chromium", args: PLAIN_ARGS });
+  const gpu = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ARGS });
+  try {
+    await waitForServer();
+    mkdirSync(FIGURES, { recursive: true });
+    const viewport = { viewport: { width: 1280, height: 800 } };
+    // Chromium without WebGPU: the view falls to WebGL2 by itself.
+    const first = await open(await plain.newContext(viewport), BASE);
+    await modelLoaded(first.page);
+    const made = await walk(first.page, 3);
+    await first.page.waitForTimeout(2000);
+    const shown = [];
+    const gl = await still(first.page, join(FIGURES, "figure-webgl2.png"));
+    shown.push(["WebGL2", gl]);
+    // A lost WebGL2 context: the view falls to Canvas 2D and the status line says why.
+    await first.page.evaluate(() => document.querySelector("#view").getContext("webgl2")
+      .getExtension("WEBGL_lose_context").loseContext());
+    await first.page.waitForFunction(() => document.querySelector(".viewer")?.dataset.renderer === "2d");
+    assert.match(await first.page.locator("#status").textContent(), /WebGL2 renderer stopped \(the WebGL2 context was lost\)/);
+    assert.equal(await first.page.locator("#view-renderer").textContent(), "View: Canvas 2D");
+
+    // The same motion's link, with the 2D renderer asked for: the prompt box shows the link's
+    // prompt, length and seed, and the view draws with Canvas 2D.
+    const second = await open(await plain.newContext(viewport), BASE + "?renderer=2d" + made.fragment);
+    await shows(second.page, made.hash);
+    assert.equal(await second.page.inputValue("#prompt"), "a person walks forward");
+    assert.equal(await second.page.inputValue("#seconds"), "2");
+    assert.equal(await second.page.inputValue("#seed"), "3");
+    await second.page.waitForTimeout(2000);
+    const flat = await still(second.page, join(FIGURES, "figure-2d.png"));
+    shown.push(["Canvas 2D", flat]);
+    // The skeleton toggle: thin bones instead of the body, far fewer limb pixels.
+    await second.page.click("#skeleton");
+    await second.page.waitForTimeout(500);
+    const sticks = await still(second.page, join(FIGURES, "figure-2d-skeleton.png"));
+
+    // Where WebGPU draws (SwiftShader here), for the screenshot beside the others.
+    const third = await open(await gpu.newContext(viewport), BASE + "?renderer=webgpu" + made.fragment);
+    await shows(third.page, made.hash);
+    await third.page.waitForTimeout(2000);
+    const webgpu = await still(third.page, join(FIGURES, "figure-webgpu.png"));
+    shown.push(["WebGPU", webgpu]);
+
+    for (const [name, s] of shown) {
+      const near = limbPixels(s.png, s.root, 160);
+      const corner = limbPixels(s.png, [40, 40], 40);
+      console.log(`${name}: renderer ${s.renderer}, "${s.status}", root at ${s.root.join(",")} px, ` +
+        `${s.frameMs.toFixed(2)} ms a frame (mean while playing), limb pixels near the root ${JSON.stringify(near)}`);
+      assert.equal(s.status, `View: ${name}`);
+      assert.equal(s.renderer, { WebGL2: "webgl2", "Canvas 2D": "2d", WebGPU: "webgpu" }[name]);
+      assert.ok(s.frameMs > 0 && s.frameMs < 1000, `frame time ${s.frameMs}`);
+      // Both legs' tints show around the root, and nothing of them in the far corner.
+      assert.ok(near["left leg"] > 150 && near["right leg"] > 150, `${name}: ${JSON.stringify(near)}`);
+      assert.ok(Object.values(corner).every((n) => n === 0), `${name} corner: ${JSON.stringify(corner)}`);
+    }
+    const thin = limbPixels(sticks.png, sticks.root, 160);
+    const full = limbPixels(flat.png, flat.root, 160);
+    console.log(`skeleton view: limb pixels near the root ${JSON.stringify(thin)}`);
+    assert.ok(thin["left leg"] + thin["right leg"] < 0.6 * (full["left leg"] + full["right leg"]),
+      `the skeleton is not thinner than the body: ${JSON.stringify(thin)} vs ${JSON.stringify(full)}`);
+    for (const p of [first, second, third]) {
+      assert.deepEqual(p.problems, [], "errors in the browser console");
+    }
+  } finally {
+    await plain.close();
+    await gpu.close();
     await stop(server);
   }
 });

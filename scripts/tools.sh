@@ -19,8 +19,8 @@ ensure_wasm_test_runner() {
   fi
 }
 
-# Debian's Chromium and its driver, Debian's Firefox ESR, Playwright's driver library and
-# puppeteer-core (no browser download): what the browser tests need.
+# Debian's Chromium and its driver, Debian's Firefox ESR, Playwright's driver library,
+# puppeteer-core (no browser download) and pngjs: what the browser tests need.
 ensure_browser_tools() {
   local missing=()
   command -v chromium >/dev/null || missing+=(chromium)
@@ -30,7 +30,9 @@ ensure_browser_tools() {
     echo "installing ${missing[*]} (once)"
     apt-get update -q && apt-get install -y -q "${missing[@]}"
   fi
-  if [ ! -d e2e/node_modules/playwright-core ] || [ ! -d e2e/node_modules/puppeteer-core ]; then
+  # pngjs: the figure test decodes the canvas's screenshots.
+  if [ ! -d e2e/node_modules/playwright-core ] || [ ! -d e2e/node_modules/puppeteer-core ] \
+    || [ ! -d e2e/node_modules/pngjs ]; then
     (cd e2e && npm install --no-audit --no-fund)
   fi
 }

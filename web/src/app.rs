@@ -98,6 +98,11 @@ pub struct AppState {
     /// The LLM endpoint of the Settings panel (empty: no LLM, nothing is sent anywhere).
     pub settings: RwSignal<LlmSettings>,
     pub client: StoredValue<Option<Client>, LocalStorage>,
+    /// What the prompt box holds (a share link that opens fills it with its own).
+    pub prompt: crate::ui::prompt::PromptFields,
+    /// The renderer that draws the 3D view ("WebGL2") and why the ones before it did not
+    /// ("WebGPU: no adapter"); None while none draws.
+    pub view_renderer: RwSignal<Option<(String, String)>>,
 }
 
 impl AppState {
@@ -382,6 +387,12 @@ fn open_fragment(state: AppState, fragment: &str) {
         Err(share::LinkError::NotALink) => {}
         Err(e) => state.fail(format!("This link cannot be opened: {e}.")),
         Ok(link) => {
+            // The prompt box shows what made the link, so Generate starts from it.
+            state.prompt.fill(
+                &link.prompt,
+                coma::timing::seconds(link.tokens.frames()),
+                link.seed,
+            );
             let ours = state
                 .model
                 .with_untracked(|m| m.as_ref().map(|m| m.id.clone()))
@@ -467,6 +478,8 @@ pub fn App() -> impl IntoView {
         preview: RwSignal::new(None),
         settings: RwSignal::new(crate::ui::settings::stored()),
         client: StoredValue::new_local(None),
+        prompt: crate::ui::prompt::PromptFields::default(),
+        view_renderer: RwSignal::new(None),
     };
     provide_context(state);
     watch_links(state);

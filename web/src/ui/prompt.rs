@@ -24,13 +24,45 @@ pub const EXAMPLES: [&str; 10] = [
     "a person walks backward",
 ];
 
+/// What the prompt box holds, in the page's state so a share link that opens can fill it.
+#[derive(Clone, Copy)]
+pub struct PromptFields {
+    pub text: RwSignal<String>,
+    /// None: the planner estimates each segment's length.
+    pub seconds: RwSignal<Option<f64>>,
+    pub seed: RwSignal<u64>,
+}
+
+impl Default for PromptFields {
+    /// The first example, the planner's length, seed 0.
+    fn default() -> PromptFields {
+        PromptFields {
+            text: RwSignal::new(EXAMPLES[0].to_string()),
+            seconds: RwSignal::new(None),
+            seed: RwSignal::new(0),
+        }
+    }
+}
+
+impl PromptFields {
+    /// Shows a link's prompt, its motion's length (seconds, rounded to the field's 0.2 s
+    /// steps) and its seed.
+    pub fn fill(&self, text: &str, seconds: f64, seed: u64) {
+        self.text.set(text.to_string());
+        self.seconds
+            .set((seconds.is_finite() && seconds > 0.0).then(|| (seconds * 5.0).round() / 5.0));
+        self.seed.set(seed);
+    }
+}
+
 #[component]
 pub fn PromptBox() -> impl IntoView {
     let state = expect_context::<AppState>();
-    let prompt = RwSignal::new(EXAMPLES[0].to_string());
-    // None: the planner estimates each segment's length.
-    let seconds = RwSignal::new(None::<f64>);
-    let seed = RwSignal::new(0u64);
+    let PromptFields {
+        text: prompt,
+        seconds,
+        seed,
+    } = state.prompt;
     let rounds = RwSignal::new(DEFAULT_ROUNDS);
     let generate = move || {
         let text = prompt.get_untracked().trim().to_string();

@@ -1,5 +1,5 @@
-//! The status bar: the running step with its progress, and the last message (errors stand
-//! out and say what to do).
+//! The status bar: the running step with its progress, the last message (errors stand out
+//! and say what to do) and which renderer draws the 3D view.
 
 use crate::app::{AppState, Pending};
 use coma::agents::pipeline::DEFAULT_ROUNDS;
@@ -49,6 +49,19 @@ pub fn StatusBar() -> impl IntoView {
             <span id="status" role="status" class:error=move || state.status.with(|s| s.error)>
                 {move || state.status.with(|s| s.text.clone())}
             </span>
+            {move || {
+                state
+                    .view_renderer
+                    .get()
+                    .map(|(name, reasons)| {
+                        view! {
+                            <span id="view-renderer" class="view-renderer" title=reasons>
+                                "View: "
+                                {name}
+                            </span>
+                        }
+                    })
+            }}
             <Show when=move || state.foreign_link.with(Option::is_some)>
                 <button on:click=regenerate>"Regenerate from its prompt"</button>
             </Show>

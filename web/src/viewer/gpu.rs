@@ -1,25 +1,41 @@
-//! The viewer's WebGPU renderer on the page's canvas: one pipeline for triangles (bones and
-//! joints, depth-tested), one for lines (grid and root path), one uniform (the camera).
-//! It owns its own GPU device: the models run in a worker, and a device cannot cross threads.
+//! The viewer's wgpu renderer on the page's canvas, on the browser's WebGPU or on WebGL2
+//! (wgpu's GL backend, with the same WGSL shader, which wgpu translates): one pipeline for
+//! triangles (the figure, lit by normal, and the shadows, blended), one for lines (grid and
+//! paths), one uniform (the camera and the light). It owns its own GPU device: the models run
+//! in a worker, and a device cannot cross threads. Errors the device reports later (a lost
+//! device, a failed validation) are kept and returned by the next [`GpuRenderer::draw`], so
+//! the viewer can fall to another renderer instead of the page panicking.
 
-use super::scene::{vertex_bytes, Mat4, Vertex, VERTEX_BYTES};
+use super::scene::{
+    shadow_triangles, vertex_bytes, Frame, Vertex, AMBIENT, BACKGROUND, DIFFUSE, LIGHT, SKY,
+    VERTEX_BYTES,
+};
+use std::sync::{Arc, Mutex};
+use wasm_bindgen::closure::Closure;
+use wasm_bindgen::JsCast;
 
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-const BACKGROUND: wgpu::Color = wgpu::Color {
-    r: 0.93,
-    g: 0.945,
-    b: 0.965,
-    a: 1.0,
-};
+/// The uniform: a 4×4 matrix and two vec4s.
+const UNIFORM_BYTES: u64 = 96;
 
-/// What one frame draws.
-pub struct Frame<'a> {
-    pub view_projection: Mat4,
-    pub triangles: &'a [Vertex],
-    pub lines: &'a [Vertex],
+/// Which of the browser's GPU interfaces draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GpuApi {
+    WebGpu,
+    WebGl2,
 }
 
-pub struct Renderer {
+impl GpuApi {
+    fn name(self) -> &'static str {
+        match self {
+            GpuApi::WebGpu => "WebGPU",
+            GpuApi::WebGl2 => "WebGL2",
+        }
+    }
+}
+
+/// The wgpu renderer of one canvas.
+pub struct GpuRenderer {
     // The instance and adapter must outlive the device: the browser loses a device whose
     // instance is gone.
     _instance: wgpu::Instance,
@@ -33,8 +49,13 @@ pub struct Renderer {
     camera: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     depth: wgpu::TextureView,
-    /// Vertex buffers reused across frames (triangles, lines), grown when a frame needs more.
-    vertices: [Option<(wgpu::Buffer, u64)>; 2],
+    /// 1 when the canvas format is sRGB (the shader then decodes the sRGB colours).
+    srgb: f32,
+    /// Vertex buffers reused across frames (lines, shadows, body), grown when a frame needs
+    /// more.
+    vertices: [Option<(wgpu::Buffer, u64)>; 3],
+    /// The first error the device reported after creation (lost, out of memory, invalid).
+    failure: Arc<Mutex<Option<String>>>,
 }
 
 fn depth_view(device: &wgpu::Device, width: u32, height: u32) -> wgpu::TextureView {
@@ -56,33 +77,98 @@ fn depth_view(device: &wgpu::Device, width: u32, height: u32) -> wgpu::TextureVi
         .create_view(&wgpu::TextureViewDescriptor::default())
 }
 
-impl Renderer {
-    /// A renderer on `canvas` (sized in device pixels by the caller).
-    pub async fn new(canvas: web_sys::HtmlCanvasElement) -> Result<Renderer, String> {
+/// Keeps the first message, so the cause is reported rather than its consequences.
+fn keep_first(slot: &Mutex<Option<String>>, message: String) {
+    if let Ok(mut s) = slot.lock() {
+        s.get_or_insert(message);
+    }
+}
+
+impl GpuRenderer {
+    /// A renderer on `canvas` (sized in device pixels by the caller) through `api`. A canvas
+    /// takes one kind of context for good: after a failure here, use a fresh canvas.
+    pub async fn new(
+        canvas: web_sys::HtmlCanvasElement,
+        api: GpuApi,
+    ) -> Result<GpuRenderer, String> {
         let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        if api == GpuApi::WebGpu && !crate::browser::has_webgpu() {
+            return Err("this browser offers no WebGPU".into());
+        }
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
-            backends: wgpu::Backends::BROWSER_WEBGPU,
+            backends: match api {
+                GpuApi::WebGpu => wgpu::Backends::BROWSER_WEBGPU,
+                GpuApi::WebGl2 => wgpu::Backends::GL,
+            },
             ..wgpu::InstanceDescriptor::new_without_display_handle()
         });
+        let name = api.name();
+        let failure = Arc::new(Mutex::new(None));
+        if api == GpuApi::WebGl2 {
+            // wgpu does not report a lost WebGL context as a lost device; the canvas does.
+            let lost = failure.clone();
+            let listener = Closure::<dyn FnMut()>::new(move || {
+                keep_first(&lost, "the WebGL2 context was lost".into());
+            });
+            canvas
+                .add_event_listener_with_callback(
+                    "webglcontextlost",
+                    listener.as_ref().unchecked_ref(),
+                )
+                .map_err(|e| format!("cannot watch the canvas's WebGL2 context: {e:?}"))?;
+            // Lives as long as the canvas, which the next renderer replaces.
+            listener.forget();
+        }
         let surface = instance
             .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
-            .map_err(|e| format!("the canvas cannot show WebGPU: {e}"))?;
+            .map_err(|e| format!("the canvas cannot show {name}: {e}"))?;
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 compatible_surface: Some(&surface),
                 ..Default::default()
             })
             .await
-            .map_err(|e| format!("no WebGPU adapter: {e}"))?;
+            .map_err(|e| format!("no {name} adapter: {e}"))?;
+        // WebGL2's limits are below WebGPU's defaults; the viewer needs little of either.
         let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor::default())
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("viewer"),
+                required_limits: wgpu::Limits::downlevel_webgl2_defaults()
+                    .using_resolution(adapter.limits()),
+                ..Default::default()
+            })
             .await
-            .map_err(|e| format!("no WebGPU device: {e}"))?;
-        let config = surface
+            .map_err(|e| format!("no {name} device: {e}"))?;
+        let lost = failure.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            keep_first(
+                &lost,
+                format!("the {name} device was lost ({reason:?}: {message})"),
+            );
+        });
+        let invalid = failure.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            keep_first(&invalid, format!("{name} reported an error: {e}"));
+        }));
+
+        let caps = surface.get_capabilities(&adapter);
+        // A non-sRGB format when there is one: the colours are sRGB already.
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb())
+            .or_else(|| caps.formats.first().copied())
+            .ok_or_else(|| format!("the canvas offers no {name} format"))?;
+        let mut config = surface
             .get_default_config(&adapter, width, height)
-            .ok_or("the canvas does not support this adapter")?;
+            .ok_or_else(|| format!("the canvas does not support this {name} adapter"))?;
+        config.format = format;
         surface.configure(&device, &config);
 
+        // Pipelines that do not validate (a shader the GL translation refuses) are caught
+        // here, so the viewer can fall to the next renderer.
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("viewer.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/viewer.wgsl").into()),
@@ -91,7 +177,7 @@ impl Renderer {
         // buffers mapped at creation.
         let camera = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("camera"),
-            size: 64,
+            size: UNIFORM_BYTES,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -99,7 +185,7 @@ impl Renderer {
             label: Some("camera"),
             entries: &[wgpu::BindGroupLayoutEntry {
                 binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Uniform,
                     has_dynamic_offset: false,
@@ -121,7 +207,7 @@ impl Renderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x4];
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4];
         let pipeline = |topology: wgpu::PrimitiveTopology| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("viewer"),
@@ -164,20 +250,25 @@ impl Renderer {
         };
         let triangles = pipeline(wgpu::PrimitiveTopology::TriangleList);
         let lines = pipeline(wgpu::PrimitiveTopology::LineList);
+        if let Some(e) = scope.pop().await {
+            return Err(format!("{name} refused the viewer's pipelines: {e}"));
+        }
         let depth = depth_view(&device, width, height);
-        Ok(Renderer {
+        Ok(GpuRenderer {
             _instance: instance,
             _adapter: adapter,
             surface,
             device,
             queue,
+            srgb: if config.format.is_srgb() { 1.0 } else { 0.0 },
             config,
             triangles,
             lines,
             camera,
             bind_group,
             depth,
-            vertices: [None, None],
+            vertices: [None, None, None],
+            failure,
         })
     }
 
@@ -217,35 +308,57 @@ impl Renderer {
         }
     }
 
-    /// Width / height of the canvas.
-    pub fn aspect(&self) -> f32 {
-        self.config.width as f32 / self.config.height.max(1) as f32
-    }
-
-    /// Draws one frame; false when the canvas had no texture to draw into this time.
-    pub fn draw(&mut self, frame: &Frame) -> bool {
+    /// Draws one frame: Ok(false) when the canvas had no texture to draw into this time,
+    /// an error once the device has failed (the renderer is then of no further use).
+    pub fn draw(&mut self, frame: &Frame) -> Result<bool, String> {
+        if let Some(e) = self.failure.lock().ok().and_then(|f| f.clone()) {
+            return Err(e);
+        }
         let texture = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface.configure(&self.device, &self.config);
-                return false;
+                return Ok(false);
             }
-            _ => return false,
+            _ => return Ok(false),
         };
-        let mut matrix = Vec::with_capacity(64);
-        for x in frame.view_projection.iter().flatten() {
-            matrix.extend_from_slice(&x.to_le_bytes());
+        let mut uniform = Vec::with_capacity(UNIFORM_BYTES as usize);
+        let params = [self.srgb, AMBIENT, SKY, DIFFUSE];
+        let light = [LIGHT[0], LIGHT[1], LIGHT[2], 0.0];
+        for x in frame
+            .view_projection
+            .iter()
+            .flatten()
+            .chain(&light)
+            .chain(&params)
+        {
+            uniform.extend_from_slice(&x.to_le_bytes());
         }
-        self.queue.write_buffer(&self.camera, 0, &matrix);
-        let tri = self.upload(0, frame.triangles);
-        let lin = self.upload(1, frame.lines);
+        self.queue.write_buffer(&self.camera, 0, &uniform);
+        let shadows = shadow_triangles(frame.shadows);
+        let uploaded = [
+            self.upload(0, frame.lines),
+            self.upload(1, &shadows),
+            self.upload(2, frame.body),
+        ];
+        let buffers = [
+            (&uploaded[0], frame.lines.len(), &self.lines),
+            (&uploaded[1], shadows.len(), &self.triangles),
+            (&uploaded[2], frame.body.len(), &self.triangles),
+        ];
         let view = texture
             .texture
             .create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let background = wgpu::Color {
+            r: BACKGROUND[0] as f64,
+            g: BACKGROUND[1] as f64,
+            b: BACKGROUND[2] as f64,
+            a: 1.0,
+        };
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("viewer"),
@@ -254,7 +367,7 @@ impl Renderer {
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(BACKGROUND),
+                        load: wgpu::LoadOp::Clear(background),
                         store: wgpu::StoreOp::Store,
                     },
                 })],
@@ -271,19 +384,17 @@ impl Renderer {
                 multiview_mask: None,
             });
             pass.set_bind_group(0, &self.bind_group, &[]);
-            if let Some(b) = &lin {
-                pass.set_pipeline(&self.lines);
-                pass.set_vertex_buffer(0, b.slice(..));
-                pass.draw(0..frame.lines.len() as u32, 0..1);
-            }
-            if let Some(b) = &tri {
-                pass.set_pipeline(&self.triangles);
-                pass.set_vertex_buffer(0, b.slice(..));
-                pass.draw(0..frame.triangles.len() as u32, 0..1);
+            // Lines, then shadows over the grid, then the figure.
+            for (buffer, count, pipeline) in buffers {
+                if let Some(b) = buffer {
+                    pass.set_pipeline(pipeline);
+                    pass.set_vertex_buffer(0, b.slice(..));
+                    pass.draw(0..count as u32, 0..1);
+                }
             }
         }
         self.queue.submit([encoder.finish()]);
         self.queue.present(texture);
-        true
+        Ok(true)
     }
 }
