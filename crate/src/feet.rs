@@ -23,8 +23,8 @@
 //! the page), so a share link, which carries tokens, rebuilds the same cleaned motion.
 
 use crate::features::{
-    features_to_joints_with_final, recover_root, FeatureFrame, Features, CONTACTS, POSITIONS,
-    ROOT_HEIGHT, ROTATIONS, VELOCITIES,
+    features_to_joints_with_final, recover_root, write_pose_columns, FeatureFrame, Features,
+    CONTACTS, ROTATIONS,
 };
 use crate::geom::{self, Quat, Vec3};
 use crate::limb::two_bone;
@@ -407,34 +407,14 @@ fn rewrite(features: &[FeatureFrame], original: &[Pose], poses: &[Pose]) -> Feat
     let (facing, _) = recover_root(features);
     let before: Vec<Rotations> = inverse_kinematics(original, true);
     let after: Vec<Rotations> = inverse_kinematics(poses, true);
-    let legs = [
-        joint::L_HIP,
-        joint::R_HIP,
-        joint::L_KNEE,
-        joint::R_KNEE,
-        joint::L_ANKLE,
-        joint::R_ANKLE,
-        joint::L_FOOT,
-        joint::R_FOOT,
-    ];
+    let legs: Vec<usize> = LEGS.iter().flat_map(|leg| leg.joints).collect();
     features
         .iter()
         .enumerate()
         .map(|(t, row)| {
             let mut out = *row;
-            let (pose, next, facing) = (&poses[t], &poses[t + 1], facing[t]);
-            let root = pose[0];
-            out[ROOT_HEIGHT.start] = root[1] as f32;
-            for (j, p) in pose.iter().enumerate().skip(1) {
-                let local = [p[0] - root[0], p[1], p[2] - root[2]];
-                let c = POSITIONS.start + (j - 1) * 3;
-                out[c..c + 3].copy_from_slice(&facing.rotate(local).map(|v| v as f32));
-            }
-            for (j, (now, then)) in pose.iter().zip(next).enumerate() {
-                let v = facing.rotate(geom::sub(*then, *now));
-                let c = VELOCITIES.start + j * 3;
-                out[c..c + 3].copy_from_slice(&v.map(|v| v as f32));
-            }
+            let pose = &poses[t];
+            write_pose_columns(&mut out, pose, &poses[t + 1], facing[t]);
             // Relative to the pelvis: a frame only lifted keeps its rotations.
             let moved = legs.iter().any(|&j| {
                 let now = geom::sub(pose[j], pose[0]);
@@ -455,7 +435,7 @@ fn rewrite(features: &[FeatureFrame], original: &[Pose], poses: &[Pose]) -> Feat
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::features::{features_to_joints, joints_to_features};
+    use crate::features::{features_to_joints, joints_to_features, POSITIONS, ROOT_HEIGHT};
     use crate::posture::measure::foot_skating;
     use crate::skeleton::{forward_kinematics, max_bone_deviation, Offsets, PARENTS};
 

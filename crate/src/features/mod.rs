@@ -268,22 +268,29 @@ pub fn with_reference_bones(features: &[FeatureFrame]) -> Features {
         .enumerate()
         .map(|(t, row)| {
             let mut out = *row;
-            let (pose, next, facing) = (&poses[t], &poses[t + 1], rots[t]);
-            let root = pose[0];
-            out[ROOT_HEIGHT.start] = root[1] as f32;
-            for (j, p) in pose.iter().enumerate().skip(1) {
-                let local = [p[0] - root[0], p[1], p[2] - root[2]];
-                let c = POSITIONS.start + (j - 1) * 3;
-                out[c..c + 3].copy_from_slice(&facing.rotate(local).map(|v| v as f32));
-            }
-            for (j, (now, then)) in pose.iter().zip(next).enumerate() {
-                let v = facing.rotate(geom::sub(*then, *now));
-                let c = VELOCITIES.start + j * 3;
-                out[c..c + 3].copy_from_slice(&v.map(|v| v as f32));
-            }
+            write_pose_columns(&mut out, &poses[t], &poses[t + 1], rots[t]);
             out
         })
         .collect()
+}
+
+/// Writes the columns of `row` that follow from where the joints are: the root height, the
+/// root-relative positions of `pose` and the joint velocities towards `next` (the following
+/// pose), both turned into the body's `facing` frame. The root's turn and travel and the 6D
+/// rotations are left as they are.
+pub fn write_pose_columns(row: &mut FeatureFrame, pose: &Pose, next: &Pose, facing: Quat) {
+    let root = pose[0];
+    row[ROOT_HEIGHT.start] = root[1] as f32;
+    for (j, p) in pose.iter().enumerate().skip(1) {
+        let local = [p[0] - root[0], p[1], p[2] - root[2]];
+        let c = POSITIONS.start + (j - 1) * 3;
+        row[c..c + 3].copy_from_slice(&facing.rotate(local).map(|v| v as f32));
+    }
+    for (j, (now, then)) in pose.iter().zip(next).enumerate() {
+        let v = facing.rotate(geom::sub(*then, *now));
+        let c = VELOCITIES.start + j * 3;
+        row[c..c + 3].copy_from_slice(&v.map(|v| v as f32));
+    }
 }
 
 /// Mirrors features left/right: the result describes exactly the mirrored joints (X negated,
