@@ -6,10 +6,12 @@
 //! drifts a few centimetres a frame (SPAM's foot skating was 0.203 against 0.056 for real
 //! motions, `EVAL.md`). [`plant_feet`], on features that are not normalised:
 //! 1. finds the contacts of each foot joint (ankle, toe): frames where the joint is near its
-//!    lowest height and either the model's contact channel says so or it barely moves;
-//! 2. pins each contact span where the joint is on average over the span, and eases the pin in
-//!    and out over [`BLEND_FRAMES`] (two spans of one joint close together hand the offset
-//!    from one to the other), so feet never jump;
+//!    lowest height and either the model's contact channel says so or it barely moves; where
+//!    no joint is in contact, the lower foot carries the body;
+//! 2. pins each contact span where the joint is on average over the span (a slide longer than
+//!    [`STEP_M`] is cut into stances with a step between), and eases the pin in and out over
+//!    [`BLEND_FRAMES`] (two spans of one joint close together hand the offset from one to the
+//!    other), so feet never jump;
 //! 3. puts the lowest pinned contact on the floor (y = 0) and keeps every foot joint above it;
 //!    a foot that moves along the floor out of contact (a swing that skims the ground) is
 //!    raised to clear it by [`SWING_CLEARANCE_M`];
@@ -19,8 +21,8 @@
 //! 6. writes the features again: root height, root-relative positions and velocities from the
 //!    new joints, and the legs' 6D rotations turned by as much as their bones turned.
 //!
-//! It is deterministic (the same features give the same joints, bit for bit, natively and in
-//! the page), so a share link, which carries tokens, rebuilds the same cleaned motion.
+//! It is deterministic (no randomness, no state: the same features give the same joints on the
+//! same build), so a share link, which carries tokens, rebuilds the same cleaned motion.
 
 use crate::features::{
     features_to_joints_with_final, recover_root, write_pose_columns, FeatureFrame, Features,
