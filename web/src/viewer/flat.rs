@@ -202,20 +202,32 @@ mod tests {
         }
     }
 
-    #[test]
-    fn nearer_triangles_come_last_and_the_target_lands_in_the_middle() {
-        let camera = OrbitCamera {
+    /// The default camera turned to look at the character's face, level (from +Z).
+    fn facing_camera() -> OrbitCamera {
+        OrbitCamera {
             yaw: 0.0,
             pitch: 0.0,
             ..OrbitCamera::default()
-        };
+        }
+    }
+
+    /// A small unlit triangle around `target`, `z` metres towards the facing camera.
+    fn unlit_triangle(target: V3, z: f32) -> [Vertex; 3] {
+        [[-0.1, -0.1, z], [0.1, -0.1, z], [0.0, 0.1, z]].map(|d| {
+            lit(
+                [target[0] + d[0], target[1] + d[1], target[2] + d[2]],
+                UNLIT,
+            )
+        })
+    }
+
+    #[test]
+    fn nearer_triangles_come_last_and_the_target_lands_in_the_middle() {
+        let camera = facing_camera();
         let m = camera.view_projection(1.0);
         let t = camera.target;
         // Two unlit triangles around the target, one 1 m nearer the camera (+Z).
-        let tri = |z: f32| {
-            [[-0.1, -0.1, z], [0.1, -0.1, z], [0.0, 0.1, z]]
-                .map(|d| lit([t[0] + d[0], t[1] + d[1], t[2] + d[2]], UNLIT))
-        };
+        let tri = |z: f32| unlit_triangle(t, z);
         let mut vertices = tri(1.0).to_vec();
         vertices.extend(tri(0.0));
         let flat = flat_triangles(&vertices, &m, camera.eye(), [200.0, 100.0]);
@@ -230,11 +242,7 @@ mod tests {
 
     #[test]
     fn faces_turned_away_are_dropped_and_lit_faces_are_shaded() {
-        let camera = OrbitCamera {
-            yaw: 0.0,
-            pitch: 0.0,
-            ..OrbitCamera::default()
-        };
+        let camera = facing_camera();
         let m = camera.view_projection(1.0);
         let t = camera.target;
         let tri = |normal: V3| {
@@ -320,17 +328,10 @@ mod tests {
 
     #[test]
     fn whole_parts_paint_back_to_front() {
-        let camera = OrbitCamera {
-            yaw: 0.0,
-            pitch: 0.0,
-            ..OrbitCamera::default()
-        };
+        let camera = facing_camera();
         let m = camera.view_projection(1.0);
         let t = camera.target;
-        let tri = |z: f32| {
-            [[-0.1, -0.1, z], [0.1, -0.1, z], [0.0, 0.1, z]]
-                .map(|d| lit([t[0] + d[0], t[1] + d[1], t[2] + d[2]], UNLIT))
-        };
+        let tri = |z: f32| unlit_triangle(t, z);
         // Part 0: triangles at z = 0 and z = 0.6 (mean 0.3); part 1: one at z = 0.4, whose own
         // depth lies between part 0's two.
         let vertices: Vec<Vertex> = [tri(0.0), tri(0.6), tri(0.4)].concat();
