@@ -8,8 +8,9 @@
 //! 1. finds the contacts of each foot joint (ankle, toe): frames where the joint is near its
 //!    lowest height and either the model's contact channel says so or it barely moves; where
 //!    no joint is in contact, the lower foot carries the body;
-//! 2. pins each contact span where the joint is on average over the span (a slide longer than
-//!    [`STEP_M`] is cut into stances with a step between), and eases the pin in and out over
+//! 2. pins each contact span, along the floor, where the joint is on average over the span
+//!    (the joint keeps the height the model gave it; a slide longer than [`STEP_M`] is cut
+//!    into stances with a step between), and eases the pin in and out over
 //!    [`BLEND_FRAMES`] (two spans of one joint close together hand the offset from one to the
 //!    other), so feet never jump;
 //! 3. puts the lowest pinned contact on the floor (y = 0) and keeps every foot joint above it;
@@ -227,12 +228,15 @@ fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
     out
 }
 
-/// Per frame, the pin's weight (0–1) and the offset that would put the joint on its pin
-/// (metres): inside a span the full offset; between two spans the offset of one handed to the
+/// Per frame, the pin's weight (0–1) and the horizontal offset that would put the joint over
+/// its pin (metres): inside a span the full offset; between two spans the offset of one handed to the
 /// other's with an eased blend; the weight eases from 1 to 0 over [`BLEND_FRAMES`] on either
 /// side of a span.
 fn pin_offsets(spans: &[Span], positions: &[Vec3]) -> Vec<(f64, Vec3)> {
-    let offset = |t: usize, s: &Span| geom::sub(s.pin, positions[t]);
+    // Along the floor only: the height the model gave a stance foot (a heel rolling, a toe
+    // pushing off) is its own, and pulling it onto the pin's height turns the knee and ankle
+    // away from the model's leg; step 3 still keeps it above the floor.
+    let offset = |t: usize, s: &Span| [s.pin[0] - positions[t][0], 0.0, s.pin[2] - positions[t][2]];
     let reach = (BLEND_FRAMES + 1) as f64;
     let fade = |gap: usize| geom::ease(1.0 - gap as f64 / reach);
     (0..positions.len())
@@ -517,7 +521,9 @@ mod tests {
         for (a, b) in after.iter().zip(&before) {
             for j in [0, 3, 6, 9, 12, 15, 20, 21, joint::R_KNEE, joint::R_FOOT] {
                 let b = [b[j][0], b[j][1] + lift, b[j][2]];
-                assert!(geom::dist(a[j], b) < 1e-5, "joint {j} moved");
+                // 0.1 mm: the stance foot keeps its own f32 height, so the floor rule may
+                // lift a frame by a rounding step.
+                assert!(geom::dist(a[j], b) < 1e-4, "joint {j} moved");
             }
         }
     }

@@ -22,6 +22,7 @@ use crate::skeleton::Pose;
 use crate::timing::FPS;
 use anyhow::Result;
 use burn::prelude::*;
+use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
 
 /// How the protocol is run.
@@ -158,6 +159,10 @@ pub enum Source<'a> {
     /// SPAM, generating a motion of the test motion's length from the caption with these
     /// sampling options (each motion's seed replaces theirs).
     Spam(&'a Spam, &'a SamplingOptions),
+    /// The very motions of [`Source::Spam`] (same captions, lengths and seeds) as the VQ-VAE
+    /// decodes them, before the engine's clean-up (reference skeleton, planted feet): what
+    /// the clean-up costs or gains in every figure. Decoded once for both rows.
+    SpamDecoded(&'a Spam, &'a SamplingOptions),
     /// The same, then reviewed for up to `rounds` rounds by the loop of
     /// the engine ([`crate::session`]) with the evaluator as judge (no LLM): the caption is one
     /// segment. No multimodality (it would cost ten reviewed motions a caption). A reviewed
@@ -282,6 +287,9 @@ impl Protocol<'_> {
         let nearest = self.nearest_training();
         let mut figures: Vec<Figures> = sources.iter().map(|_| Figures::default()).collect();
         for repeat in 0..options.repeats {
+            // Decoded motions (denormalised) by seed, so the planted and the as-decoded rows
+            // measure the same samples for the price of one generation.
+            let decoded_by_seed: RefCell<HashMap<u64, Vec<FeatureFrame>>> = Default::default();
             let mut rng = Rng::new(options.seed ^ (repeat as u64 + 1).wrapping_mul(0x9E37_79B9));
             let mut order = captioned.clone();
             rng.shuffle(&mut order);
@@ -314,20 +322,32 @@ impl Protocol<'_> {
                             .map(|c| self.train.items[nearest[c]].features.as_slice())
                             .collect();
                     }
-                    Source::Spam(spam, sampling) => {
+                    Source::Spam(spam, sampling) | Source::SpamDecoded(spam, sampling) => {
+                        let planted = matches!(source, Source::Spam(..));
+                        let normalizer = &self.test.normalizer;
                         let generate = |sentence: &[f32; TEXT_DIM], frames: usize, seed: u64| {
-                            block_on(async {
-                                let options = SamplingOptions {
-                                    seed,
-                                    ..(*sampling).clone()
-                                };
-                                let text = part_text(sentence, &[]);
-                                let tokens = spam.generate(&text, frames.min(196), &options).await;
-                                // Measured as the engine shows it (feet planted).
-                                let normalizer = &self.test.normalizer;
-                                let decoded = normalizer.denormalize(&spam.decode(&tokens).await);
+                            let decoded = decoded_by_seed
+                                .borrow_mut()
+                                .entry(seed)
+                                .or_insert_with(|| {
+                                    block_on(async {
+                                        let options = SamplingOptions {
+                                            seed,
+                                            ..(*sampling).clone()
+                                        };
+                                        let text = part_text(sentence, &[]);
+                                        let tokens =
+                                            spam.generate(&text, frames.min(196), &options).await;
+                                        normalizer.denormalize(&spam.decode(&tokens).await)
+                                    })
+                                })
+                                .clone();
+                            if planted {
+                                // As the engine shows it.
                                 normalizer.normalize(&finish(&decoded))
-                            })
+                            } else {
+                                normalizer.normalize(&decoded)
+                            }
                         };
                         let length = |k: usize| self.test.items[order[k]].features.len();
                         generated = sentences

@@ -5,7 +5,7 @@ use super::protocol::{markdown_table, ProtocolOptions, Row};
 use std::collections::BTreeMap;
 
 /// Rows in the order the tables show them.
-pub const ROW_ORDER: [&str; 4] = ["real", "retrieval", "spam", "spam_review"];
+pub const ROW_ORDER: [&str; 5] = ["real", "retrieval", "spam_decoded", "spam", "spam_review"];
 
 /// Control probes of the model (absent when no SPAM model was measured).
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -98,7 +98,8 @@ fn describe(name: &str) -> &'static str {
         "retrieval" => {
             "the training motion whose caption is nearest (MiniLM cosine) to the test caption"
         }
-        "spam" => "SPAM, one shot, a motion of the test motion's length from the caption, measured as the engine hands it out (on the reference skeleton, feet planted)",
+        "spam_decoded" => "SPAM, one shot, a motion of the test motion's length from the caption, as the VQ-VAE decodes it (before the engine's clean-up)",
+        "spam" => "the same motions, measured as the engine hands them out (on the reference skeleton, feet planted)",
         "spam_review" => {
             "the same, then reviewed (up to K rounds, no LLM) with the evaluator as judge; the \
              judge is the evaluator that measures, so R-precision and MM-Dist favour this row \

@@ -174,6 +174,10 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
     let agent_options = &options.agents;
     let mut sources = vec![("real", Source::Real), ("retrieval", Source::Retrieval)];
     if let (Some(session), Some(model)) = (&session, spam) {
+        sources.push((
+            "spam_decoded",
+            Source::SpamDecoded(&model.spam, &options.sampling),
+        ));
         sources.push(("spam", Source::Spam(&model.spam, &options.sampling)));
         if agent_options.review_rounds > 0 {
             sources.push((

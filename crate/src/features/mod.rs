@@ -672,9 +672,12 @@ mod tests {
         for (a, b) in root_a.iter().zip(&root_b) {
             assert_eq!([a[0], a[2]], [b[0], b[2]]);
         }
-        // Fixing twice changes nothing more.
+        // Fixing twice changes nothing more, but for a limb stretched to full reach: the
+        // features' f32 rounding of its length (~1e-7 m) bends its knee or elbow by the square
+        // root of that, a fraction of a millimetre.
         let again = features_to_joints(&with_reference_bones(&fixed));
-        assert!(skeleton::max_joint_distance(&joints, &again) < 1e-5);
+        let moved = skeleton::max_joint_distance(&joints, &again);
+        assert!(moved < 1e-3, "fixing again moved a joint by {moved} m");
     }
 
     #[test]
