@@ -8,19 +8,23 @@
 //! 1. finds the contacts of each foot joint (ankle, toe): frames where the joint is near its
 //!    lowest height and either the model's contact channel says so or it barely moves; where
 //!    no joint is in contact, the lower foot carries the body;
-//! 2. pins each contact span, along the floor, where the joint is on average over the span
+//! 2. moves the whole body back by the slide of its stillest firm contact, so it travels only
+//!    as far as its feet carry it (a generated body glides over its stance foot, most of all
+//!    around a jump), except along a path the person asked for;
+//! 3. pins each contact span, along the floor, where the joint is on average over the span
 //!    (the joint keeps the height the model gave it; a slide longer than [`STEP_M`] is cut
 //!    into stances with a step between), and eases the pin in and out over
 //!    [`BLEND_FRAMES`] (two spans of one joint close together hand the offset from one to the
 //!    other), so feet never jump;
-//! 3. puts the lowest pinned contact on the floor (y = 0) and keeps every foot joint above it;
+//! 4. puts the lowest pinned contact on the floor (y = 0) and keeps every foot joint above it;
 //!    a foot that moves along the floor out of contact (a swing that skims the ground) is
 //!    raised to clear it by [`SWING_CLEARANCE_M`];
-//! 4. bends each leg onto its targets by two-bone IK from the hip ([`crate::limb::two_bone`]),
-//!    which keeps every bone's length; the pelvis and the upper body do not move;
-//! 5. lifts a frame whose other joints (knees, hands, a lying body) would be under the floor;
-//! 6. writes the features again: root height, root-relative positions and velocities from the
-//!    new joints, and the legs' 6D rotations turned by as much as their bones turned.
+//! 5. bends each leg onto its targets by two-bone IK from the hip ([`crate::limb::two_bone`]),
+//!    which keeps every bone's length; the upper body does not move about the pelvis;
+//! 6. lifts a frame whose other joints (knees, hands, a lying body) would be under the floor;
+//! 7. writes the features again: the root's height and travel, root-relative positions and
+//!    velocities from the new joints, and the legs' 6D rotations turned by as much as their
+//!    bones turned.
 //!
 //! It is deterministic (no randomness, no state: the same features give the same joints on the
 //! same build), so a share link, which carries tokens, rebuilds the same cleaned motion.
@@ -33,6 +37,7 @@ use crate::geom::{self, Quat, Vec3};
 use crate::limb::two_bone;
 use crate::skeleton::{inverse_kinematics, joint, Pose, Rotations};
 use crate::timing::FPS;
+use std::ops::Range;
 
 /// Height above a foot joint's lowest point in the motion (metres) under which it can be in
 /// contact with the floor.
@@ -88,7 +93,7 @@ struct Span {
 /// floor: near its lowest height and either marked so by the model's contact channel or
 /// moving slower than [`PLANT_SPEED`]; where no joint is, the low joints of the lower foot. `poses` has one pose more than `features` has rows
 /// (the last row's velocities lead to it); that pose takes the last row's channel.
-fn contacts(features: &[FeatureFrame], poses: &[Pose]) -> Vec<[bool; 4]> {
+fn contacts(features: &[FeatureFrame], poses: &[Pose]) -> Vec<Contact> {
     let (lowest, down) = lowest_points(poses);
     (0..poses.len())
         .map(|t| {
@@ -101,6 +106,7 @@ fn contacts(features: &[FeatureFrame], poses: &[Pose]) -> Vec<[bool; 4]> {
                 let slow = horizontal_speed(poses, FEET[k], t) < PLANT_SPEED;
                 low[k] && (marked || slow)
             });
+            let firm = contact;
             // A body near the floor stands on something: with no foot joint in contact, the
             // low joints of the lower foot carry it (a generated run's stance foot slides
             // with the body and is marked as lifted).
@@ -120,9 +126,53 @@ fn contacts(features: &[FeatureFrame], poses: &[Pose]) -> Vec<[bool; 4]> {
                     contact[k] = low[k];
                 }
             }
-            contact
+            Contact { on: contact, firm }
         })
         .collect()
+}
+
+/// One frame's contacts of the four foot joints ([`FEET`] order).
+#[derive(Clone, Copy)]
+struct Contact {
+    /// In contact with the floor.
+    on: [bool; 4],
+    /// In contact by the model's channel or by standing still, not only as the lower foot of
+    /// a body with no other support: these may carry the body along the floor.
+    firm: [bool; 4],
+}
+
+/// Per frame, how far (metres, horizontal) the whole body moves so that it travels only as
+/// far as its feet carry it: between two frames in which a foot joint is firmly in contact,
+/// the body is moved back by that joint's slide along the floor, taking the joint that slides
+/// least (the one that bears the weight; a foot starting its swing still counts as firm for a
+/// frame or two). A generated body often glides over its stance foot, most of all while it
+/// gathers for a jump or lands from one (a jump forward covered 1.4 m against the real clips'
+/// 1.0); moving the body instead of the foot keeps the legs as the model made them. In flight
+/// and between stances nothing firm holds the body and its travel is its own.
+fn glide_corrections(contact: &[Contact], poses: &[Pose], root_held: &[Range<usize>]) -> Vec<Vec3> {
+    let mut shift = [0.0; 3];
+    let mut out = vec![shift; poses.len()];
+    for t in 1..poses.len() {
+        if root_held
+            .iter()
+            .any(|r| r.contains(&(t - 1)) && r.contains(&t))
+        {
+            out[t] = shift;
+            continue;
+        }
+        let slide = (0..FEET.len())
+            .filter(|&k| contact[t - 1].firm[k] && contact[t].firm[k])
+            .map(|k| {
+                let d = geom::sub(poses[t][FEET[k]], poses[t - 1][FEET[k]]);
+                [d[0], 0.0, d[2]]
+            })
+            .min_by(|a, b| geom::norm(*a).total_cmp(&geom::norm(*b)));
+        if let Some(slide) = slide {
+            shift = geom::sub(shift, slide);
+        }
+        out[t] = shift;
+    }
+    out
 }
 
 /// Each foot joint's lowest height over the motion, and whether it comes down to the floor at
@@ -235,7 +285,7 @@ fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
 fn pin_offsets(spans: &[Span], positions: &[Vec3]) -> Vec<(f64, Vec3)> {
     // Along the floor only: the height the model gave a stance foot (a heel rolling, a toe
     // pushing off) is its own, and pulling it onto the pin's height turns the knee and ankle
-    // away from the model's leg; step 3 still keeps it above the floor.
+    // away from the model's leg; step 4 still keeps it above the floor.
     let offset = |t: usize, s: &Span| [s.pin[0] - positions[t][0], 0.0, s.pin[2] - positions[t][2]];
     let reach = (BLEND_FRAMES + 1) as f64;
     let fade = |gap: usize| geom::ease(1.0 - gap as f64 / reach);
@@ -303,8 +353,10 @@ fn bend_leg(pose: &mut Pose, leg: &Leg, [ankle_target, toe_target]: [Vec3; 2]) {
 }
 
 /// The same motion with planted feet (see the module's doc): features that are not
-/// normalised in, as many rows out. Motions of fewer than 2 rows come back unchanged.
-pub fn plant_feet(features: &[FeatureFrame]) -> Features {
+/// normalised in, as many rows out. `root_held` are the feature rows whose root travel was
+/// laid on purpose (a path): the body there is never carried back to its feet, so the path
+/// keeps its shape. Motions of fewer than 2 rows come back unchanged.
+pub fn plant_feet(features: &[FeatureFrame], root_held: &[Range<usize>]) -> Features {
     if features.len() < 2 {
         return features.to_vec();
     }
@@ -313,10 +365,15 @@ pub fn plant_feet(features: &[FeatureFrame]) -> Features {
         return features.to_vec();
     }
     let contact = contacts(features, &original);
+    let carried: Vec<Pose> = original
+        .iter()
+        .zip(glide_corrections(&contact, &original, root_held))
+        .map(|(p, d)| p.map(|v| geom::add(v, d)))
+        .collect();
     let spans: Vec<Vec<Span>> = (0..FEET.len())
         .map(|k| {
-            let on: Vec<bool> = contact.iter().map(|c| c[k]).collect();
-            let at: Vec<Vec3> = original.iter().map(|p| p[FEET[k]]).collect();
+            let on: Vec<bool> = contact.iter().map(|c| c.on[k]).collect();
+            let at: Vec<Vec3> = carried.iter().map(|p| p[FEET[k]]).collect();
             spans(&on, &at)
         })
         .collect();
@@ -327,8 +384,8 @@ pub fn plant_feet(features: &[FeatureFrame]) -> Features {
         .flatten()
         .map(|s| s.pin[1])
         .reduce(f64::min)
-        .unwrap_or_else(|| crate::skeleton::lowest_joint(&original));
-    let mut poses: Vec<Pose> = original
+        .unwrap_or_else(|| crate::skeleton::lowest_joint(&carried));
+    let mut poses: Vec<Pose> = carried
         .iter()
         .map(|p| p.map(|v| [v[0], v[1] - floor, v[2]]))
         .collect();
@@ -408,9 +465,15 @@ pub fn plant_feet(features: &[FeatureFrame]) -> Features {
 }
 
 /// `features` rewritten to describe `poses` (one more than the rows), whose pelvis differs
-/// from `original`'s only in height and whose legs may have turned.
+/// from `original`'s in height and in travel along the floor and whose legs may have turned.
 fn rewrite(features: &[FeatureFrame], original: &[Pose], poses: &[Pose]) -> Features {
     let (facing, _) = recover_root(features);
+    // A row's root velocity is the step to the next pose in that pose's facing.
+    let last = features[features.len() - 1][0] as f64;
+    let facing_next = |t: usize| match facing.get(t + 1) {
+        Some(q) => *q,
+        None => facing[t].mul(Quat([last.cos(), 0.0, last.sin(), 0.0])),
+    };
     let before: Vec<Rotations> = inverse_kinematics(original, true);
     let after: Vec<Rotations> = inverse_kinematics(poses, true);
     let legs: Vec<usize> = LEGS.iter().flat_map(|leg| leg.joints).collect();
@@ -421,6 +484,13 @@ fn rewrite(features: &[FeatureFrame], original: &[Pose], poses: &[Pose]) -> Feat
             let mut out = *row;
             let pose = &poses[t];
             write_pose_columns(&mut out, pose, &poses[t + 1], facing[t]);
+            let step = geom::sub(poses[t + 1][0], pose[0]);
+            let was = geom::sub(original[t + 1][0], original[t][0]);
+            if (step[0] - was[0]).hypot(step[2] - was[2]) > 1e-9 {
+                let v = facing_next(t).rotate([step[0], 0.0, step[2]]);
+                out[1] = v[0] as f32;
+                out[2] = v[2] as f32;
+            }
             // Relative to the pelvis: a frame only lifted keeps its rotations.
             let moved = legs.iter().any(|&j| {
                 let now = geom::sub(pose[j], pose[0]);
@@ -487,7 +557,7 @@ mod tests {
         let features = sliding_left_foot();
         let before = features_to_joints(&features);
         let skating_before = foot_skating(&before);
-        let cleaned = plant_feet(&features);
+        let cleaned = plant_feet(&features, &[]);
         assert_eq!(cleaned.len(), features.len());
         let after = features_to_joints(&cleaned);
         assert!(
@@ -528,6 +598,41 @@ mod tests {
         }
     }
 
+    /// A standing person carried sideways along +X at `speed` (m/s) over frames 10–30, feet
+    /// and all, as a generated body glides; the pelvis's travel before and after cleaning.
+    fn glide(speed: f64) -> (f64, f64) {
+        let mut poses = standing(40);
+        for (t, pose) in poses.iter_mut().enumerate() {
+            let x = speed / FPS * t.clamp(10, 30).saturating_sub(10) as f64;
+            for v in pose.iter_mut() {
+                v[0] += x;
+            }
+        }
+        let features = features_of(&poses);
+        let travel = |p: &[Pose]| geom::dist(p[0][0], p[p.len() - 1][0]);
+        let before = features_to_joints(&features);
+        let after = features_to_joints(&plant_feet(&features, &[]));
+        (travel(&before), travel(&after))
+    }
+
+    #[test]
+    fn a_body_gliding_over_its_standing_feet_stays_where_its_feet_are() {
+        let (before, after) = glide(0.3);
+        assert!(before > 0.29, "the test body travels {before} m");
+        assert!(after < 0.01, "travelled {after} m on feet that stand");
+    }
+
+    #[test]
+    fn a_body_moving_fast_with_its_feet_off_keeps_its_travel() {
+        // 2 m/s: no foot is marked in contact or still, so nothing firm holds the body.
+        let (before, after) = glide(2.0);
+        assert!(before > 1.9, "the test body travels {before} m");
+        assert!(
+            (after - before).abs() < 1e-3,
+            "travel {before} m became {after} m"
+        );
+    }
+
     #[test]
     fn the_lowest_contact_is_on_the_floor_and_nothing_is_under_it() {
         // The whole motion 7 cm too high, and one frame's knee pushed under the floor.
@@ -538,7 +643,7 @@ mod tests {
                 row[POSITIONS.start + (j - 1) * 3 + 1] += 0.07;
             }
         }
-        let cleaned = plant_feet(&features);
+        let cleaned = plant_feet(&features, &[]);
         let poses = features_to_joints(&cleaned);
         let lowest = crate::skeleton::lowest_joint(&poses);
         // Within a millimetre: a toe reaches its pin only as far as the foot's length allows.
@@ -546,7 +651,7 @@ mod tests {
         let mut sunk = features.clone();
         let knee = POSITIONS.start + (joint::L_KNEE - 1) * 3 + 1;
         sunk[10][knee] = -0.05;
-        let poses = features_to_joints(&plant_feet(&sunk));
+        let poses = features_to_joints(&plant_feet(&sunk, &[]));
         assert!(crate::skeleton::lowest_joint(&poses) > -1e-5);
     }
 
@@ -561,7 +666,7 @@ mod tests {
             }
         }
         let features = features_of(&poses);
-        let after = features_to_joints(&plant_feet(&features));
+        let after = features_to_joints(&plant_feet(&features, &[]));
         let before = features_to_joints(&features);
         for t in 15..23 {
             let (a, b) = (after[t][joint::L_FOOT][1], before[t][joint::L_FOOT][1]);
@@ -572,13 +677,13 @@ mod tests {
     #[test]
     fn cleaning_is_deterministic_and_a_clean_motion_stays_nearly_as_it_is() {
         let features = sliding_left_foot();
-        let once = plant_feet(&features);
-        assert_eq!(once, plant_feet(&features));
-        let twice = plant_feet(&once);
+        let once = plant_feet(&features, &[]);
+        assert_eq!(once, plant_feet(&features, &[]));
+        let twice = plant_feet(&once, &[]);
         let (a, b) = (features_to_joints(&once), features_to_joints(&twice));
         assert!(crate::skeleton::max_joint_distance(&a, &b) < 0.01);
         let still = features_of(&standing(30));
-        let kept = plant_feet(&still);
+        let kept = plant_feet(&still, &[]);
         let moved = crate::skeleton::max_joint_distance(
             &features_to_joints(&still),
             &features_to_joints(&kept),
@@ -588,12 +693,12 @@ mod tests {
 
     #[test]
     fn odd_input_comes_back_unchanged() {
-        assert!(plant_feet(&[]).is_empty());
+        assert!(plant_feet(&[], &[]).is_empty());
         let one = [[0.0f32; 263]];
-        assert_eq!(plant_feet(&one), one.to_vec());
+        assert_eq!(plant_feet(&one, &[]), one.to_vec());
         let mut bad = sliding_left_foot();
         bad[3][ROOT_HEIGHT.start] = f32::NAN;
-        let out = plant_feet(&bad);
+        let out = plant_feet(&bad, &[]);
         assert_eq!(out.len(), bad.len());
         assert!(out[3][ROOT_HEIGHT.start].is_nan());
     }
@@ -603,7 +708,7 @@ mod tests {
         // The rewritten 6D rotations of the sliding leg match the rotations computed from the
         // cleaned joints as the dataset would, within the model-to-IK gap of the input.
         let features = sliding_left_foot();
-        let cleaned = plant_feet(&features);
+        let cleaned = plant_feet(&features, &[]);
         let ik = inverse_kinematics(
             &crate::features::features_to_joints_with_final(&cleaned),
             true,

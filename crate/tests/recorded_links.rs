@@ -104,7 +104,11 @@ fn links_of_both_versions_open_to_the_motion_they_were_made_with() {
         assert_eq!(before_planting.len(), recorded.len(), "{name}");
         let worst = skeleton::max_joint_distance(&before_planting, &recorded);
         assert!(worst < 2e-5, "{name}: joints differ by up to {worst} m");
-        let planted: Vec<Pose> = features_to_joints(&plant_feet(&decoded));
+        let paths = link
+            .plan
+            .plan()
+            .map_or_else(Vec::new, |plan| pipeline::path_ranges(plan, &link.tokens));
+        let planted: Vec<Pose> = features_to_joints(&plant_feet(&decoded, &paths));
         let shown: Vec<Pose> = motion
             .joints
             .iter()

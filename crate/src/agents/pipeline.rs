@@ -356,6 +356,17 @@ async fn blend(
     joined
 }
 
+/// Feature rows whose root travel is a path laid on purpose (segments with a trajectory):
+/// what [`crate::feet::plant_feet`] must not carry back to the feet.
+pub fn path_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range<usize>> {
+    plan.segments
+        .iter()
+        .zip(segment_ranges(plan, tokens))
+        .filter(|(s, _)| s.trajectory.is_some())
+        .map(|(_, r)| r)
+        .collect()
+}
+
 /// Feature rows of each segment in the blended motion: blending keeps every segment's
 /// length, so segment `i` starts where the ones before it end.
 pub fn segment_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range<usize>> {

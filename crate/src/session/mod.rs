@@ -330,7 +330,8 @@ impl Session {
             _ => (features, notes),
         };
         // Feet planted last, on whatever was laid, so every motion leaves with them.
-        let features = plant_feet(&features);
+        let paths = plan.map_or_else(Vec::new, |plan| pipeline::path_ranges(plan, &tokens));
+        let features = plant_feet(&features, &paths);
         let joints = features_to_joints(&features)
             .iter()
             .map(|p| p.map(|j| j.map(|v| v as f32)))
@@ -348,7 +349,7 @@ impl Session {
 /// key postures on them: on the reference skeleton, feet planted. The evaluation measures
 /// SPAM's motions through it, so it measures what a user sees.
 pub fn finish(features: &[FeatureFrame]) -> Features {
-    plant_feet(&with_reference_bones(features))
+    plant_feet(&with_reference_bones(features), &[])
 }
 
 /// The training vocabulary from its file.
