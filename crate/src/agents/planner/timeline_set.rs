@@ -19,12 +19,16 @@
 //!   is out of order");
 //! - is on the right side (left, right, or the way a path turns: clockwise is right);
 //! - happens as many times as asked (repeated identical clips, a posture track's repeat, or
-//!   "twice" / "N times" in the element's text), and walks the path asked for.
+//!   "twice" / "N times" in the element's text; walking or running in two clips in a row is
+//!   one longer walk, not two), and walks the path asked for.
 //!
 //! A clause is **silently lost** when no plan element is matched to it and no plan note names
-//! it; a **side swap** when its element is on the opposite side. A context clause (track
-//! `none`) is right when no element is matched to it and a note names it (dropped with a
-//! note), and silently lost when neither.
+//! it (quotes its words, in part or whole, or names in its own words a movement it left out
+//! that means the clause; the substitute a note says it used for a clause does not count); a
+//! **side swap** when its element is on the opposite side. A context clause (track `none`) is
+//! right when a note names it and no movement stands in its place (neither an element that
+//! means it nor the substitute the note says it used), and silently lost when nothing names
+//! it.
 //!
 //! **Matching by meaning.** A clause's words (or its `means`, for anaphora) and an element's
 //! text (with its path, if it walks one) are the same movement when the cosine similarity of
@@ -56,6 +60,8 @@
 
 use super::offline::Embedder;
 use crate::plan::Plan;
+use crate::posture::library::Library;
+use crate::posture::script::PostureScript;
 use crate::skeleton::BodyPart;
 use serde::{Deserialize, Serialize};
 use std::cell::RefCell;
@@ -485,9 +491,9 @@ fn text_count(text: &str) -> u32 {
 
 /// What a plan holds, element by element, with times from the segments' lengths: each
 /// segment's base motion (with its path), each body-part instruction (parts with the same
-/// instruction as one element: "both arms"), and each posture track (the names of its key
-/// poses; a track that holds both legs carries the whole body, and the base motion under it
-/// is replaced).
+/// instruction as one element: "both arms"), and each posture track (the library movement it
+/// plays, else the names of its key poses; a track that holds both legs carries the whole
+/// body and its path, and the base motion under it is replaced).
 pub fn plan_elements(plan: &Plan) -> Vec<Element> {
     let mut out = Vec::new();
     let mut t = 0.0;
@@ -531,17 +537,8 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
                 Some([a, b]) => ((start + a).min(end), (start + b).min(end)),
                 None => (start, end),
             };
-            let mut names: Vec<String> = Vec::new();
-            for key in &track.keys {
-                let name = key
-                    .script
-                    .name
-                    .clone()
-                    .unwrap_or_else(|| key.script.in_words());
-                if !names.contains(&name) {
-                    names.push(name);
-                }
-            }
+            let names = distinct_names(track.keys.iter().map(|k| &k.script));
+            let text = library_movement(&names).unwrap_or_else(|| names.join(", "));
             let mut parts = track.parts.clone();
             parts.sort();
             out.push(Element {
@@ -550,16 +547,44 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
                 } else {
                     On::Parts(parts)
                 },
-                text: names.join(", "),
+                text,
                 start: from,
                 end: to,
                 count: track.repeat.max(1),
-                path: s.trajectory.as_ref().map(|t| t.describe()),
+                // The root's path is the body's: a track on the arms does not walk it.
+                path: s
+                    .trajectory
+                    .as_ref()
+                    .filter(|_| posture_body)
+                    .map(|t| t.describe()),
                 segment: k,
             });
         }
     }
     out
+}
+
+/// The names of key poses in order, each once (a pose without a name in words).
+fn distinct_names<'a>(scripts: impl Iterator<Item = &'a PostureScript>) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for script in scripts {
+        let name = script.name.clone().unwrap_or_else(|| script.in_words());
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    names
+}
+
+/// The posture library's movement whose key poses a track plays, by their names: a track of
+/// "crouch to jump, landing, standing" is the library's "jump", and that is what the plan
+/// does (the key names alone do not say it).
+fn library_movement(names: &[String]) -> Option<String> {
+    Library::builtin()
+        .actions
+        .iter()
+        .find(|a| distinct_names(a.keys.iter().map(|k| &k.script)) == names)
+        .map(|a| a.name.clone())
 }
 
 /// Words of opposite directions, and the two gaits: a clause and a text that each name one
@@ -1107,6 +1132,20 @@ fn interval(elements: &[Element], run: &[usize]) -> (f64, f64) {
         })
 }
 
+/// Movements that go on rather than happen a number of times: gaits (walking, running,
+/// crawling, …). Two identical elements of these in a row are one longer movement.
+fn continuous(text: &str) -> bool {
+    const MORE: [&str; 10] = [
+        "crawl", "crawls", "crawling", "march", "marches", "marching", "sneak", "sneaks",
+        "shuffle", "shuffles",
+    ];
+    let gaits = &OPPOSITES[3];
+    words(text).iter().any(|w| {
+        let w = w.as_str();
+        gaits.0.contains(&w) || gaits.1.contains(&w) || MORE.contains(&w)
+    })
+}
+
 /// Whether two elements are the same movement said again in the next segment.
 fn repeats(a: &Element, b: &Element) -> bool {
     b.segment == a.segment + 1 && a.text == b.text && a.on == b.on && a.path == b.path
@@ -1189,10 +1228,12 @@ impl Problem<'_> {
 
     /// How many times clause `i` happens placed as `choice`, given every element claimed:
     /// identical elements right before or after the run that no clause claims repeat it too.
-    /// A clause that rides over others is one clip held across segments, not repeated.
+    /// A clause that rides over others is one clip held across segments, and walking or
+    /// running in two segments in a row is one longer walk or run: neither is repeated.
     fn count(&self, i: usize, choice: &Choice, claimed: &[bool]) -> u32 {
         let counts = choice.elements.iter().map(|&k| self.elements[k].count);
-        if !self.clauses[i].over.is_empty() {
+        let first = &self.elements[choice.elements[0]];
+        if !self.clauses[i].over.is_empty() || continuous(&first.text) {
             return counts.max().unwrap_or(1);
         }
         let mut n: u32 = counts.sum();
@@ -1507,7 +1548,7 @@ pub fn score_prompt(p: &SetPrompt, plan: &Plan, matcher: &Matcher) -> PromptOutc
     let named = |c: &Clause| {
         plan.notes
             .iter()
-            .find(|n| note_names(n, c, matcher))
+            .find(|n| note_names(n, c, &p.prompt, &elements, matcher))
             .cloned()
     };
     let mut extra: Vec<String> = elements
@@ -1524,17 +1565,24 @@ pub fn score_prompt(p: &SetPrompt, plan: &Plan, matcher: &Matcher) -> PromptOutc
             let mut placed_as = Vec::new();
             let mut similarity = None;
             if c.track == Track::None {
-                // Context placed as a movement: an element no clause claimed that means it.
+                // Context placed as a movement: an element no clause claimed that means it,
+                // or the movement a note says was used in its place.
+                let note = named(c);
                 let as_movement = elements
                     .iter()
                     .enumerate()
                     .filter(|(k, _)| !claimed[*k])
-                    .find_map(|(_, e)| matcher.same(c.meaning(), &e.said()).map(|s| (e, s)));
-                match (as_movement, named(c)) {
+                    .find_map(|(_, e)| matcher.same(c.meaning(), &e.said()).map(|s| (e, Some(s))))
+                    .or_else(|| {
+                        let note = note.as_deref()?;
+                        note_pieces(note)
+                            .find_map(|piece| in_plan(piece, &elements).map(|e| (e, None)))
+                    });
+                match (as_movement, note) {
                     (Some((e, s)), _) => {
                         extra.retain(|x| *x != e.describe());
                         placed_as.push(e.describe());
-                        similarity = Some(s);
+                        similarity = s;
                         misses.push(Miss::ContextPlaced);
                     }
                     (None, Some(_)) => {}
@@ -1570,18 +1618,68 @@ pub fn score_prompt(p: &SetPrompt, plan: &Plan, matcher: &Matcher) -> PromptOutc
     }
 }
 
-/// Whether a plan note names a clause: one of its pieces (the note cut at quotes, colons
-/// and semicolons, as notes quote the clauses they drop and list what they leave out) holds
-/// all of the clause's words, or means the same movement.
-fn note_names(note: &str, clause: &Clause, matcher: &Matcher) -> bool {
-    let own = words(&clause.text);
+/// A note cut at quotes, colons and semicolons: notes quote the clauses they drop and list
+/// what they leave out.
+fn note_pieces(note: &str) -> impl Iterator<Item = &str> {
     note.split(['"', ':', ';'])
         .map(str::trim)
         .filter(|piece| !piece.is_empty())
-        .any(|piece| {
-            let have = words(piece);
-            own.iter().all(|w| have.contains(w)) || matcher.same(clause.meaning(), piece).is_some()
-        })
+}
+
+/// Where the words of `piece` stand in `text` in a row: the word positions of every place.
+fn places(piece: &str, text: &str) -> Vec<std::ops::Range<usize>> {
+    let (p, t) = (words(piece), words(text));
+    if p.is_empty() || p.len() > t.len() {
+        return Vec::new();
+    }
+    (0..=t.len() - p.len())
+        .filter(|&k| t[k..k + p.len()] == p[..])
+        .map(|k| k..k + p.len())
+        .collect()
+}
+
+/// The element a note piece names, if the plan holds it: the piece's words begin the
+/// element's text, after "a person" (the nearest movement the planner used instead of a
+/// clause, as its notes name it: "kicks with the right leg").
+fn in_plan<'e>(piece: &str, elements: &'e [Element]) -> Option<&'e Element> {
+    let p = words(piece);
+    elements.iter().find(|e| {
+        let said = words(&e.said());
+        let said = match said.as_slice() {
+            [a, person, rest @ ..] if a == "a" && person == "person" => rest,
+            all => all,
+        };
+        !p.is_empty() && said.starts_with(&p)
+    })
+}
+
+/// Whether a plan note names a clause. A piece that is a movement the plan holds (the
+/// substitute the planner used for some clause) names none; a piece that quotes the prompt
+/// names the clauses whose words it covers, in part or whole (the planner quotes the words it
+/// could not plan, cut as it cut them); a piece in the note's own words (a segment it left
+/// out) names a clause when it holds all of the clause's words or means the same movement.
+fn note_names(
+    note: &str,
+    clause: &Clause,
+    prompt: &str,
+    elements: &[Element],
+    matcher: &Matcher,
+) -> bool {
+    let own = words(&clause.text);
+    let at = places(&clause.text, prompt);
+    note_pieces(note).any(|piece| {
+        if in_plan(piece, elements).is_some() {
+            return false;
+        }
+        let quoted = places(piece, prompt);
+        if !quoted.is_empty() {
+            return quoted
+                .iter()
+                .any(|q| at.iter().any(|c| q.start < c.end && c.start < q.end));
+        }
+        let have = words(piece);
+        own.iter().all(|w| have.contains(w)) || matcher.same(clause.meaning(), piece).is_some()
+    })
 }
 
 #[cfg(test)]

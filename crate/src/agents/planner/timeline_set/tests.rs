@@ -308,6 +308,14 @@ fn context_is_right_only_when_dropped_with_a_note() {
     let substituted = plan(vec![stomp(), segment("a person kicks", &[])], &[]);
     let out = score_prompt(&set.prompts[0], &substituted, &matcher());
     assert_eq!(out.extra, vec!["[3.0–6.0 s body] a person kicks"]);
+    // Context the planner replaced by a movement, as its note says, is not dropped.
+    let replaced = plan(
+        vec![stomp(), segment("a person kicks", &[])],
+        &["\"to protest a verdict\" is not a movement the model knows; used the nearest one, \"kicks\""],
+    );
+    let out = score_prompt(&set.prompts[0], &replaced, &matcher());
+    assert_eq!(out.clauses[1].misses, vec![Miss::ContextPlaced]);
+    assert!(out.extra.is_empty(), "{out:#?}");
 }
 
 #[test]
@@ -459,4 +467,74 @@ fn calibration_picks_the_middle_of_the_widest_best_gap() {
     assert!((cal.threshold - 0.575).abs() < 0.002, "{cal:?}");
     assert_eq!(cal.false_same.len(), 1);
     assert_eq!(cal.false_same[0].0, "f");
+}
+
+#[test]
+fn a_substitute_in_a_note_does_not_account_for_a_clause() {
+    let bows = &prompt().clauses[2];
+    let substituted = "\"claps\" is not a movement the model knows; used the nearest one, \"bows\"";
+    let bow = plan_elements(&plan(vec![bow()], &[]));
+    let text = "A man walks forward while waving his left hand, then bows twice.";
+    // The plan holds the bow: the note names what it used for another clause.
+    assert!(!note_names(substituted, bows, text, &bow, &matcher()));
+    // A movement the plan left out, in the note's own words, names the clause.
+    let left_out = "a plan has at most 4 segments; left out: a person bows";
+    assert!(note_names(left_out, bows, text, &[], &matcher()));
+    // A quote of the prompt names the clauses whose words it covers, in part or whole.
+    let quoted = "\"then bows\" names no movement the model makes; left out";
+    assert!(note_names(quoted, bows, text, &bow, &matcher()));
+    let elsewhere = "\"walks forward\" names no movement the model makes; left out";
+    assert!(!note_names(elsewhere, bows, text, &bow, &matcher()));
+}
+
+#[test]
+fn tracks_of_library_movements_are_named_by_them() {
+    let jump = Library::builtin()
+        .actions
+        .iter()
+        .find(|a| a.name == "jump")
+        .unwrap();
+    let p = plan(
+        vec![Segment {
+            postures: Some(jump.track(Some(2), [0.0, 0.0])),
+            ..segment("a person stands still", &[])
+        }],
+        &[],
+    );
+    let elements = plan_elements(&p);
+    assert_eq!(elements.len(), 1, "{elements:?}");
+    assert_eq!((elements[0].text.as_str(), elements[0].count), ("jump", 2));
+    assert_eq!(elements[0].on, On::Body);
+}
+
+#[test]
+fn a_walk_over_two_segments_is_one_walk_and_arm_postures_walk_no_path() {
+    use crate::trajectory::{Shape, Side as PathSide, Trajectory};
+    let p = plan(
+        vec![
+            segment("a person walks forward", &[]),
+            walk_waving(BodyPart::LeftArm),
+            bow(),
+            bow(),
+        ],
+        &[],
+    );
+    let out = score_prompt(&prompt(), &p, &matcher());
+    assert!(out.clauses[0].correct, "{out:#?}");
+    let t_pose = Library::builtin().get("T-pose").unwrap();
+    let circling = Segment {
+        trajectory: Some(Trajectory::Shape {
+            shape: Shape::Circle(PathSide::Left),
+        }),
+        postures: Some(PostureTrack::holding(
+            vec![BodyPart::LeftArm, BodyPart::RightArm],
+            t_pose.script.clone(),
+        )),
+        ..segment("a person walks forward", &[])
+    };
+    let elements = plan_elements(&plan(vec![circling], &[]));
+    assert!(
+        elements[0].path.is_some() && elements[1].path.is_none(),
+        "{elements:?}"
+    );
 }
