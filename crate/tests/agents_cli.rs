@@ -59,6 +59,77 @@ fn plan_scores_the_prompt_set() {
 }
 
 #[test]
+fn plan_scores_the_timeline_set_clause_by_clause() {
+    let set = repo().join("crate/tests/fixtures/timeline_small.json");
+    let run = |json: bool| {
+        let mut cmd = coma();
+        cmd.args(["plan", "--timeline-set"])
+            .arg(&set)
+            .arg("--models")
+            .arg(repo().join("static/models"));
+        if json {
+            cmd.arg("--json");
+        }
+        stdout(&cmd.output().unwrap())
+    };
+    let report: serde_json::Value = serde_json::from_str(&run(true)).unwrap();
+    assert_eq!(report["prompts"], 3, "{report:#}");
+    assert_eq!(report["clauses"], 8, "{report:#}");
+    let results = report["results"].as_array().unwrap();
+    assert_eq!(results.len(), 3);
+    // The README's own kind of prompt: both clauses on the body track, in order.
+    for clause in results[0]["clauses"].as_array().unwrap() {
+        assert_eq!(clause["correct"], true, "{:#}", results[0]);
+    }
+    let count = |key: &str| report[key].as_u64().unwrap();
+    let clauses = results
+        .iter()
+        .flat_map(|r| r["clauses"].as_array().unwrap());
+    let correct = clauses.clone().filter(|c| c["correct"] == true).count() as u64;
+    let lost = clauses
+        .filter(|c| {
+            c["misses"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|m| m["kind"] == "lost")
+        })
+        .count() as u64;
+    assert_eq!(count("correct"), correct);
+    assert_eq!(count("silently_lost"), lost);
+    assert!(report["planner_seconds"].as_f64().unwrap() > 0.0);
+    let text = run(false);
+    for line in [
+        "clauses placed correctly: ",
+        "clauses silently lost: ",
+        "side swaps: ",
+        "prompts with every clause placed correctly: ",
+        "planner time: ",
+    ] {
+        assert!(text.contains(line), "{text}");
+    }
+    assert!(!text.contains("✗ walk-bow"), "{text}");
+    // A clause whose words are not in its prompt is a bad file, named as such.
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.json");
+    let written = std::fs::read_to_string(&set)
+        .unwrap()
+        .replace("\"text\": \"bows\"", "\"text\": \"curtsies\"");
+    std::fs::write(&bad, written).unwrap();
+    let out = coma()
+        .args(["plan", "--timeline-set"])
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("prompt \"walk-bow\", clause 1 (\"curtsies\"): its text is not in the prompt"),
+        "{err}"
+    );
+}
+
+#[test]
 fn traj_draws_a_clockwise_circle_that_closes() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("circle.png");

@@ -388,3 +388,32 @@ fn convert_minilm_into_static_models() {
     .unwrap();
     println!("{report:#?}");
 }
+
+// ---- the timeline scorer's meaning match (`coma::agents::planner::timeline_set`) ----
+
+/// The threshold at which the timeline scorer calls a clause and a plan text the same movement
+/// is the one the hand-labelled pairs calibrate with the shipped encoder.
+#[test]
+fn timeline_scorer_threshold_is_calibrated_on_the_labelled_pairs() {
+    use coma::agents::planner::timeline_set::{
+        calibrate, embedding_similarity, load_pairs, SAME_MOVEMENT_MIN_SIMILARITY,
+    };
+    let pairs =
+        load_pairs(&root().join("crate/tests/fixtures/timeline_similarity_pairs.json")).unwrap();
+    assert!(pairs.len() >= 100);
+    let embed = |s: &str| encoder().encode(&[s])[0].to_vec();
+    let similarity = embedding_similarity(&embed);
+    let cal = calibrate(&pairs, &similarity);
+    println!("{cal:#?}");
+    assert!(
+        (cal.lowest..=cal.highest).contains(&SAME_MOVEMENT_MIN_SIMILARITY),
+        "the threshold {SAME_MOVEMENT_MIN_SIMILARITY} is outside the calibrated range {:.3}..{:.3}",
+        cal.lowest,
+        cal.highest
+    );
+    assert!(
+        cal.smoothed_accuracy >= 0.85,
+        "{:.3}",
+        cal.smoothed_accuracy
+    );
+}

@@ -10,3 +10,4 @@ pub mod llm;
 pub mod offline;
 pub mod postures;
 pub mod prompt_set;
+pub mod timeline_set;

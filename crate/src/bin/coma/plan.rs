@@ -1,19 +1,21 @@
 //! `coma plan`: the plan of a prompt (segments, base motions, part edits, paths), or the
-//! planner scored on a prompt set.
+//! planner scored on a prompt set or on the timeline prompt set.
 
 use crate::common::{llm_of, LlmArgs};
 use anyhow::Result;
 use clap::Args;
 use coma::agents::planner;
+use coma::agents::planner::timeline_set;
 use coma::executor::block_on;
 use coma::plan::Plan;
 use coma::session::{self, PlanningContext, Progress, VOCABULARY_FILE};
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 #[derive(Args)]
 pub struct PlanArgs {
     /// The prompt.
-    #[arg(required_unless_present = "prompts")]
+    #[arg(required_unless_present_any = ["prompts", "timeline_set"])]
     prompt: Option<String>,
     #[command(flatten)]
     llm: LlmArgs,
@@ -24,6 +26,12 @@ pub struct PlanArgs {
     /// report how often the segment count matches the prompt's temporal structure.
     #[arg(long, conflicts_with = "prompt")]
     prompts: Option<PathBuf>,
+    /// Instead of one prompt, plan every prompt of a timeline prompt set
+    /// (eval/timeline_prompts.json) and report how many of its clauses are placed correctly
+    /// (track, order, overlap, side, count), silently lost or on the swapped side, with every
+    /// miss and its reason.
+    #[arg(long, conflicts_with_all = ["prompt", "prompts"])]
+    timeline_set: Option<PathBuf>,
     /// Stretch or shrink the plan to about this many seconds (as the page's Seconds field).
     #[arg(long)]
     seconds: Option<f64>,
@@ -65,20 +73,17 @@ pub fn run(args: PlanArgs) -> Result<()> {
     if let Err(e) = &vocabulary {
         eprintln!("note: {e}");
     }
-    let encoder =
-        coma::text::minilm::SentenceEncoder::from_dir(&args.models, &burn::tensor::Device::flex())
-            .ok();
+    let loaded =
+        coma::text::minilm::SentenceEncoder::from_dir(&args.models, &burn::tensor::Device::flex());
+    let encoder = loaded.as_ref().ok();
     let embed_fn = |s: &str| {
         encoder
-            .as_ref()
             .map(|e| e.encode(&[s])[0].to_vec())
             .unwrap_or_default()
     };
     let context = PlanningContext {
         vocabulary: vocabulary.as_ref().ok(),
-        embed: encoder
-            .as_ref()
-            .map(|_| &embed_fn as planner::offline::Embedder),
+        embed: encoder.map(|_| &embed_fn as planner::offline::Embedder),
     };
     let plan_one = |prompt: &str, verbose: bool| -> Result<Plan> {
         Ok(block_on(session::plan_prompt(
@@ -100,6 +105,44 @@ pub fn run(args: PlanArgs) -> Result<()> {
         if let Some(e) = failed {
             anyhow::bail!("a prompt of the set did not plan: {e}");
         }
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            print!("{}", report.table());
+        }
+        return Ok(());
+    }
+    if let Some(path) = &args.timeline_set {
+        let set = timeline_set::load(path)?;
+        if let Err(e) = &loaded {
+            anyhow::bail!(
+                "the timeline scorer matches clauses to the plan by meaning with the sentence \
+                 encoder, which did not load from {}: {e}",
+                args.models.display()
+            );
+        }
+        let similarity = timeline_set::embedding_similarity(&embed_fn);
+        let matcher =
+            timeline_set::Matcher::new(&similarity, timeline_set::SAME_MOVEMENT_MIN_SIMILARITY);
+        let mut failed = None;
+        let mut planning = Duration::ZERO;
+        let mut report = timeline_set::score(
+            &set,
+            &mut |p| {
+                let start = Instant::now();
+                let plan = plan_one(p, false).unwrap_or_else(|e| {
+                    failed = Some(format!("'{p}': {e}"));
+                    planner::offline::plan(p, None)
+                });
+                planning += start.elapsed();
+                plan
+            },
+            &matcher,
+        );
+        if let Some(e) = failed {
+            anyhow::bail!("a prompt of the set did not plan: {e}");
+        }
+        report.planner_seconds = Some(planning.as_secs_f64());
         if args.json {
             println!("{}", serde_json::to_string_pretty(&report)?);
         } else {
