@@ -153,15 +153,11 @@ fn glide_corrections(contact: &[Contact], poses: &[Pose], root_held: &[Range<usi
     let mut shift = [0.0; 3];
     let mut out = vec![shift; poses.len()];
     for t in 1..poses.len() {
-        if root_held
+        let held = root_held
             .iter()
-            .any(|r| r.contains(&(t - 1)) && r.contains(&t))
-        {
-            out[t] = shift;
-            continue;
-        }
+            .any(|r| r.contains(&(t - 1)) && r.contains(&t));
         let slide = (0..FEET.len())
-            .filter(|&k| contact[t - 1].firm[k] && contact[t].firm[k])
+            .filter(|&k| !held && contact[t - 1].firm[k] && contact[t].firm[k])
             .map(|k| {
                 let d = geom::sub(poses[t][FEET[k]], poses[t - 1][FEET[k]]);
                 [d[0], 0.0, d[2]]
@@ -279,9 +275,9 @@ fn spans(contact: &[bool], positions: &[Vec3]) -> Vec<Span> {
 }
 
 /// Per frame, the pin's weight (0–1) and the horizontal offset that would put the joint over
-/// its pin (metres): inside a span the full offset; between two spans the offset of one handed to the
-/// other's with an eased blend; the weight eases from 1 to 0 over [`BLEND_FRAMES`] on either
-/// side of a span.
+/// its pin (metres): inside a span the full offset; between two spans the offset of one
+/// handed to the other's with an eased blend; the weight eases from 1 to 0 over
+/// [`BLEND_FRAMES`] on either side of a span.
 fn pin_offsets(spans: &[Span], positions: &[Vec3]) -> Vec<(f64, Vec3)> {
     // Along the floor only: the height the model gave a stance foot (a heel rolling, a toe
     // pushing off) is its own, and pulling it onto the pin's height turns the knee and ankle
