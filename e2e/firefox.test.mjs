@@ -160,6 +160,10 @@ test("in Firefox, the page generates a motion and its share link rebuilds the sa
       executablePath: FIREFOX,
       headless: true,
       extraPrefsFirefox: PREFS,
+      // A wait is one WebDriver BiDi command that returns when its condition holds, and
+      // puppeteer ends any command after `protocolTimeout` (180 s unless set), so the waits'
+      // own LOAD_TIMEOUT only holds with a longer one.
+      protocolTimeout: LOAD_TIMEOUT + 60_000,
     });
     const version = await browser.version();
     console.log(`browser: ${version} (${FIREFOX})`);

@@ -10,8 +10,11 @@ use serde::{Deserialize, Serialize};
 pub const MIN_SEGMENT_SECONDS: f64 = 2.0;
 /// Longest segment one generation makes, in seconds (196 frames at 20 fps).
 pub const MAX_SEGMENT_SECONDS: f64 = 9.8;
-/// Most segments in one plan.
-pub const MAX_SEGMENTS: usize = 4;
+/// Longest plan, in seconds (1200 frames at 20 fps): the whole-body track's segments add up
+/// to at most this.
+pub const MAX_PLAN_SECONDS: f64 = 60.0;
+/// Most segments in one plan: [`MAX_PLAN_SECONDS`] of the shortest.
+pub const MAX_SEGMENTS: usize = (MAX_PLAN_SECONDS / MIN_SEGMENT_SECONDS) as usize;
 /// Longest text the planner keeps for one prompt, segment or instruction, in characters:
 /// MiniLM reads 256 word pieces at most, and longer replies are a sign of a confused model.
 pub const MAX_TEXT_CHARS: usize = 300;
@@ -107,7 +110,7 @@ pub enum PlannerKind {
 
 /// A prompt turned into segments. A plan that arrives from outside the planner (a share link,
 /// a worker message, a file) is checked as it is read: 1 to [`MAX_SEGMENTS`] segments, each
-/// of finite length, clamped into what one generation makes.
+/// of finite length, clamped into what one generation makes, [`MAX_PLAN_SECONDS`] in all.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "PlanFields")]
 pub struct Plan {
@@ -156,8 +159,9 @@ impl Plan {
         self.segments.iter().map(|s| s.seconds).sum()
     }
 
-    /// The plan if it has 1 to [`MAX_SEGMENTS`] segments of finite length, with every length
-    /// clamped into what one generation makes (the plan's author may not have clamped).
+    /// The plan if it has 1 to [`MAX_SEGMENTS`] segments of finite length and lasts at most
+    /// [`MAX_PLAN_SECONDS`], with every length clamped into what one generation makes (the
+    /// plan's author may not have clamped).
     pub fn checked(mut self) -> Result<Plan, String> {
         if self.segments.is_empty() || self.segments.len() > MAX_SEGMENTS {
             return Err(format!(
@@ -168,24 +172,49 @@ impl Plan {
         for s in &mut self.segments {
             s.seconds = clamp_seconds(s.seconds).ok_or("a segment has no length")?;
         }
+        let seconds = self.seconds();
+        if seconds > MAX_PLAN_SECONDS + 1e-6 {
+            return Err(format!(
+                "a plan lasts at most {MAX_PLAN_SECONDS} s, this one {seconds:.1} s"
+            ));
+        }
         Ok(self)
     }
 
     /// Scales the segments' durations so the plan lasts about `seconds` in all (each segment
     /// still within what one generation makes), keeping their proportions: the length the
     /// user asks for overrides the planner's estimates, not its split. A length other than the
-    /// one asked for leaves a note.
+    /// one asked for (more than [`MAX_PLAN_SECONDS`], for one) leaves a note.
     pub fn fit_seconds(&mut self, seconds: f64) {
         let planned = self.seconds();
         if !seconds.is_finite() || seconds <= 0.0 || planned <= 0.0 {
             return;
         }
-        let factor = seconds / planned;
+        let factor = seconds.min(MAX_PLAN_SECONDS) / planned;
         for s in &mut self.segments {
             s.seconds = clamp_seconds(s.seconds * factor).unwrap_or(s.seconds);
         }
+        // Clamping short segments up may overshoot the longest plan: the overshoot comes off
+        // the segments that can give it, in proportion (one pass takes exactly it).
+        if self.seconds() > MAX_PLAN_SECONDS + 1e-6 {
+            let over = self.seconds() - MAX_PLAN_SECONDS;
+            let spare: f64 = self
+                .segments
+                .iter()
+                .map(|s| s.seconds - MIN_SEGMENT_SECONDS)
+                .sum();
+            let keep = 1.0 - (over / spare).min(1.0);
+            for s in &mut self.segments {
+                s.seconds = MIN_SEGMENT_SECONDS + (s.seconds - MIN_SEGMENT_SECONDS) * keep;
+            }
+        }
         let got = self.seconds();
-        if (got - seconds).abs() > 0.05 {
+        if seconds > MAX_PLAN_SECONDS {
+            self.notes.push(format!(
+                "asked for {seconds:.1} s; a plan lasts at most {MAX_PLAN_SECONDS} s, so it \
+                 makes {got:.1} s"
+            ));
+        } else if (got - seconds).abs() > 0.05 {
             self.notes.push(format!(
                 "asked for {seconds:.1} s; {} segment(s) of {MIN_SEGMENT_SECONDS} to \
                  {MAX_SEGMENT_SECONDS} s make {got:.1} s",
@@ -262,7 +291,17 @@ mod tests {
         let e = serde_json::from_str::<Plan>(&serde_json::to_string(&many).unwrap())
             .unwrap_err()
             .to_string();
-        assert!(e.contains("1 to 4 segments"), "{e}");
+        assert!(e.contains("1 to 30 segments"), "{e}");
+        // Seven segments of 9.8 s are 68.6 s: longer than a plan lasts.
+        let mut long = plan.clone();
+        long.segments = vec![plan.segments[0].clone(); 7];
+        long.segments.iter_mut().for_each(|s| s.seconds = 9.8);
+        let e = serde_json::from_str::<Plan>(&serde_json::to_string(&long).unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("at most 60 s, this one 68.6 s"), "{e}");
+        long.segments.pop();
+        assert!(serde_json::from_str::<Plan>(&serde_json::to_string(&long).unwrap()).is_ok());
     }
 
     #[test]
@@ -286,5 +325,25 @@ mod tests {
         let planned = three.clone();
         three.fit_seconds(f64::NAN);
         assert_eq!(three, planned);
+        // More than a plan lasts: 60 s, with a note; every segment still one generation.
+        three.fit_seconds(90.0);
+        assert!((three.seconds() - 29.4).abs() < 1e-9, "{}", three.seconds());
+        let mut many = planned.clone();
+        many.segments = vec![planned.segments[0].clone(); 12];
+        many.fit_seconds(200.0);
+        assert!(
+            (many.seconds() - MAX_PLAN_SECONDS).abs() < 1e-9,
+            "{}",
+            many.seconds()
+        );
+        assert!(many
+            .segments
+            .iter()
+            .all(|s| (MIN_SEGMENT_SECONDS..=MAX_SEGMENT_SECONDS).contains(&s.seconds)));
+        assert!(many
+            .notes
+            .last()
+            .unwrap()
+            .contains("at most 60 s, so it makes 60.0 s"));
     }
 }

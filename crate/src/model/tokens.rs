@@ -14,9 +14,8 @@ use serde::{Deserialize, Serialize};
 pub const PARTS: usize = 4;
 /// Most quantizer layers a motion carries.
 pub const MAX_LAYERS: usize = 8;
-/// Most token steps of one motion: a blend of four 9.8 s segments is at most 4 × 49 steps
-/// (39.2 s).
-pub const MAX_STEPS: usize = 4 * 50;
+/// Most token steps of one motion: the longest plan, 60 s at 20 fps in steps of 4 frames.
+pub const MAX_STEPS: usize = 300;
 /// Largest code: codes are 9 bits.
 pub const MAX_CODE: u32 = 511;
 

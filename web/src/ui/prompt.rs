@@ -125,7 +125,7 @@ pub fn PromptBox() -> impl IntoView {
                         id="seconds"
                         type="number"
                         min="2"
-                        max="39.2"
+                        max=coma::plan::MAX_PLAN_SECONDS.to_string()
                         step="0.2"
                         placeholder="auto"
                         prop:value=move || seconds.get().map_or(String::new(), |s| s.to_string())

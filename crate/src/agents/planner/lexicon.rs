@@ -357,6 +357,12 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
         "wave" | "waves" | "waving" | "waved" | "greet" | "greets" | "greeting" => {
             Action::Wave(Side::Right)
         }
+        // "lifts the right knee" raises a leg, which no gesture of the arms makes.
+        "raise" | "raises" | "raising" | "raised" | "lift" | "lifts" | "lifting" | "lifted"
+            if names_leg_first(next) =>
+        {
+            return None
+        }
         "raise" | "raises" | "raising" | "raised" | "lift" | "lifts" | "lifting" | "lifted"
         | "salute" | "salutes" | "saluting" | "hail" | "hails" | "cheer" | "cheers"
         | "cheering" | "celebrates" | "celebrating" | "celebration" => Action::Raise(Side::Right),
@@ -364,6 +370,22 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
         "up" | "air" if near(prev, &["hand", "hands", "arm", "arms"]) => Action::Raise(Side::Right),
         _ => return None,
     })
+}
+
+/// Whether the words after a verb name a leg before they name an arm ("the right knee up
+/// high"), within the verb's object.
+fn names_leg_first(next: &[&str]) -> bool {
+    for w in next.iter().take(4) {
+        match *w {
+            "arm" | "arms" | "hand" | "hands" | "fist" | "fists" | "elbow" | "elbows" => {
+                return false
+            }
+            "leg" | "legs" | "knee" | "knees" | "foot" | "feet" | "heel" | "heels" => return true,
+            "," | "and" | "then" | "while" | "with" => return false,
+            _ => {}
+        }
+    }
+    false
 }
 
 /// The actions of dataset v2 a loaded model makes, read from its vocabulary: an action is

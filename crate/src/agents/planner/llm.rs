@@ -10,7 +10,10 @@ use crate::agents::llm::{
     parse_json_content, LlmClient, LlmError, Message, ReplyFormat, Transport,
 };
 use crate::dataset::Vocabulary;
-use crate::plan::{clamp_seconds, clean_text, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS};
+use crate::plan::{
+    clamp_seconds, clean_text, PartEdits, Plan, PlannerKind, Segment, MAX_PLAN_SECONDS,
+    MAX_SEGMENTS,
+};
 use crate::posture::script::PostureScript;
 use crate::posture::track::{PostureTrack, TrackKey, DEFAULT_TRANSITION_SECONDS};
 use crate::skeleton::BodyPart;
@@ -229,7 +232,8 @@ impl SegmentReply {
                 self.segments.len()
             ));
         }
-        self.segments
+        let segments = self
+            .segments
             .iter()
             .enumerate()
             .map(|(i, s)| {
@@ -240,7 +244,14 @@ impl SegmentReply {
                     seconds,
                 ))
             })
-            .collect()
+            .collect::<Result<Vec<_>, String>>()?;
+        let seconds: f64 = segments.iter().map(|(_, s)| s).sum();
+        if seconds > MAX_PLAN_SECONDS + 1e-6 {
+            return Err(format!(
+                "its segments last {seconds:.1} s; give at most {MAX_PLAN_SECONDS} s in all"
+            ));
+        }
+        Ok(segments)
     }
 }
 
@@ -549,10 +560,10 @@ fn segment_messages(description: &str) -> Vec<Message> {
     vec![
         Message::system(format!(
             "Split a description of a human movement into 1 to {MAX_SEGMENTS} consecutive \
-             segments. Each segment is one complete movement that could be filmed alone; \
-             things done at the same time (walking while waving) stay in one segment, and a \
-             repeated whole-body action (bowing twice) is one segment per repetition. Give \
-             each segment a duration in seconds between 2 and 9.8 (a few steps of walking take \
+             segments, {MAX_PLAN_SECONDS} seconds at most in all. Each segment is one \
+             complete movement that could be filmed alone; things done at the same time \
+             (walking while waving) stay in one segment, and a repeated whole-body action \
+             (bowing twice) is one segment per repetition. Give each segment a duration in seconds between 2 and 9.8 (a few steps of walking take \
              about 4 s, a bow about 3 s, a wave about 3 s). Write each segment's text as a \
              full sentence about \"a person\". Reply in JSON: {{\"segments\": [{{\"text\": \
              \"...\", \"seconds\": 4}}]}}."

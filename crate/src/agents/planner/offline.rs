@@ -21,10 +21,16 @@ use super::lexicon::{self, Action, Direction, Repertoire, Side};
 use super::postures;
 use crate::dataset::Vocabulary;
 use crate::plan::{
-    clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_SEGMENTS, MAX_TEXT_CHARS,
+    clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_PLAN_SECONDS, MAX_SEGMENTS,
+    MAX_TEXT_CHARS,
 };
 use crate::skeleton::BodyPart;
 use crate::trajectory::{Shape, Trajectory};
+
+mod accounting;
+mod context;
+
+use context::Context;
 
 /// Turns a sentence into a unit embedding (MiniLM); the planner uses it to map movements it
 /// has no rule for onto the nearest action of the training data.
@@ -37,11 +43,13 @@ pub const NEAREST_MIN_SIMILARITY: f32 = 0.35;
 pub const SUBSTITUTED: &str = "is not a movement the model knows";
 /// How a note says a clause was left out of the plan.
 pub const LEFT_OUT: &str = "names no movement the model makes; left out";
+/// How a note says a part of a clause was left out of the plan (the reason follows).
+pub const NOT_PLACED: &str = "was left out of the plan";
 
 /// Whether a plan note says a clause went unplanned: planned as a different movement (the
 /// nearest one the model knows) or left out.
 pub fn is_unplanned_note(note: &str) -> bool {
-    note.contains(SUBSTITUTED) || note.contains(LEFT_OUT)
+    note.contains(SUBSTITUTED) || note.contains(LEFT_OUT) || note.contains(NOT_PLACED)
 }
 
 /// Longest prompt read, in characters; the rest is ignored with a note.
@@ -56,7 +64,7 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
 /// Plans `prompt` with the built-in rules for the model whose training vocabulary is
 /// `vocabulary`: the actions of dataset v2 it lists are made by the model. `embed` (optional)
 /// maps unknown movements onto the training actions. Always returns a plan of 1 to
-/// [`MAX_SEGMENTS`] segments.
+/// [`MAX_SEGMENTS`] segments, [`MAX_PLAN_SECONDS`] at most.
 pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Embedder>) -> Plan {
     let known = Repertoire::new(vocabulary);
     let mut notes = Vec::new();
@@ -73,10 +81,36 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     // The dataset v2 action the last segment made, whose clip ends standing again.
     let mut ends_standing: Option<Action> = None;
     let clauses = clauses(&text, known);
-    let clauses: Vec<Vec<&str>> = clauses
-        .iter()
-        .map(|c| c.iter().map(String::as_str).collect())
-        .collect();
+    let mut read: Vec<Vec<&str>> = Vec::new();
+    for clause in &clauses {
+        let words: Vec<&str> = clause.iter().map(String::as_str).collect();
+        let names_movement = movements(&words, None, Reader::alone(known)).is_some()
+            || postures::names_posture(&words)
+            || path(&words).is_some();
+        if let Some(context) = context::whole_clause(&words, names_movement) {
+            notes.push(format!(
+                "\"{}\" {}; dropped",
+                words.join(" "),
+                context.describe()
+            ));
+            continue;
+        }
+        // "waves the arms to direct traffic" names an action of the data, not a reason.
+        let names_action =
+            |from: usize| (from..words.len()).any(|k| lexicon::dataset_action(&words, k).is_some());
+        match context::reason_tail(&words).filter(|&i| !names_action(i)) {
+            Some(i) => {
+                notes.push(format!(
+                    "\"{}\" {}; dropped",
+                    words[i..].join(" "),
+                    Context::Reason.describe()
+                ));
+                read.push(words[..i].to_vec());
+            }
+            None => read.push(words),
+        }
+    }
+    let clauses = read;
     let readers: Vec<Reader> = (0..clauses.len())
         .map(|k| Reader {
             known,
@@ -88,8 +122,15 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     for (k, words) in clauses.iter().enumerate() {
         let words = words.as_slice();
         let reader = readers[k];
-        if ends_standing.is_some() && postures::stands_up(words) {
+        let only_stands_up =
+            || postures::stands_up(words) && movements(words, None, reader).is_none();
+        if let Some(action) = ends_standing.filter(|_| only_stands_up()) {
             // "squats down and stands back up": the squat's clips stand back up already.
+            notes.push(format!(
+                "\"{}\" is made by the movement before: \"{}\" ends standing",
+                words.join(" "),
+                action.verb_phrase()
+            ));
             continue;
         }
         let model = movements(words, previous, reader);
@@ -98,27 +139,29 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             .and_then(|next| movements(next, None, readers[k + 1]))
             .map(|m| m.base)
             .filter(|a| a.label().is_some());
-        if model.is_none()
-            && next_dataset_action.is_some_and(|next| postures::leads_into(words, next))
+        if let Some(next) =
+            next_dataset_action.filter(|next| model.is_none() && postures::leads_into(words, *next))
         {
             // "kneels and then lies down": the model's lying down kneels on the way.
+            notes.push(format!(
+                "\"{}\" is made by the movement after: \"{}\" passes through it",
+                words.join(" "),
+                next.verb_phrase()
+            ));
             continue;
         }
         let model_segment = || match &model {
             Some(found) => segment(words, found, style.as_deref()),
             None => segment(
                 words,
-                &Movements {
-                    base: Action::Walk(Direction::Forward),
-                    gestures: Vec::new(),
-                    at: 0,
-                },
+                &Movements::only(Action::Walk(Direction::Forward)),
                 style.as_deref(),
             ),
         };
         let model_parts = model.as_ref().map(|m| (m.base, m.gestures.as_slice()));
         if let Some(planned) = postures::plan_clause(words, model_parts, &model_segment) {
             notes.extend(planned.notes);
+            note_limb_phrases(words, &planned.named, &mut notes);
             postures::land_in(words, segments.last_mut(), &planned.segment);
             previous = None;
             ends_standing = None;
@@ -141,14 +184,22 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 (postures::Stay::Hold, Some(last)) => postures::hold_segment(words, last),
                 _ => None,
             };
+            let said = words.join(" ");
             match (held, segments.last_mut()) {
                 (Some(held), _) => segments.push(held),
                 (None, Some(last)) if stay != postures::Stay::Passing => {
                     // Staying as one is: the movement before lasts longer.
                     last.seconds = clamp_seconds(last.seconds + postures::HOLD_EXTRA_SECONDS)
                         .unwrap_or(last.seconds);
+                    notes.push(format!("\"{said}\": the movement before lasts longer"));
                 }
-                _ => {}
+                (None, _) if stay == postures::Stay::Passing => notes.push(format!(
+                    "\"{said}\" happens on the way from one movement to the next; no \
+                     movement of its own"
+                )),
+                (None, _) => notes.push(format!(
+                    "\"{said}\" {NOT_PLACED}: there is no movement before it to last longer"
+                )),
             }
             continue;
         }
@@ -162,11 +213,7 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                         words.join(" "),
                         action.verb_phrase()
                     ));
-                    Movements {
-                        base: action,
-                        gestures: Vec::new(),
-                        at: 0,
-                    }
+                    Movements::only(action)
                 }
                 None => {
                     if !words.is_empty() {
@@ -176,12 +223,42 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 }
             },
         };
-        previous = Some(found.gestures.last().copied().unwrap_or(found.base));
-        ends_standing = Some(found.base).filter(|a| a.label().is_some() && *a != Action::LieDown);
-        let segment = segment(words, &found, style.as_deref());
+        let made = segment(words, &found, style.as_deref());
         for _ in 0..repetitions(words, &found, &mut notes) {
-            segments.push(segment.clone());
+            segments.push(made.clone());
         }
+        let mut last = found.base;
+        for &(at, action) in &found.left {
+            if !action.is_gesture() && accounting::in_sequence(words, found.at, at) {
+                // "from a walk to a run": the clause moves on to it, carrying its gestures.
+                let next = Movements {
+                    base: action,
+                    gestures: found.gestures.clone(),
+                    at,
+                    left: Vec::new(),
+                    named: Vec::new(),
+                };
+                segments.push(segment(words, &next, style.as_deref()));
+                last = action;
+                continue;
+            }
+            let why = if action.is_gesture() {
+                "the arm it needs already does another movement in this clause"
+            } else {
+                "it happens at the same time as another whole-body movement of this clause, \
+                 and the body makes one at a time"
+            };
+            notes.push(format!(
+                "\"{}\" {NOT_PLACED}: {why}",
+                accounting::phrase_from(words, at)
+            ));
+        }
+        // A substitute or an inherited gesture stands for the whole clause.
+        if !found.named.is_empty() {
+            note_limb_phrases(words, &found.named, &mut notes);
+        }
+        previous = Some(found.gestures.last().copied().unwrap_or(last));
+        ends_standing = Some(last).filter(|a| a.label().is_some() && *a != Action::LieDown);
     }
     if segments.is_empty() {
         let fallback =
@@ -197,16 +274,23 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             postures: None,
         });
     }
-    if segments.len() > MAX_SEGMENTS {
-        let dropped: Vec<String> = segments[MAX_SEGMENTS..]
-            .iter()
-            .map(|s| s.text.clone())
-            .collect();
+    // The segments that fit in the longest plan; the rest are named in a note.
+    let mut total = 0.0;
+    let fit = segments
+        .iter()
+        .take_while(|s| {
+            total += s.seconds;
+            total <= MAX_PLAN_SECONDS + 1e-6
+        })
+        .count()
+        .clamp(1, MAX_SEGMENTS);
+    if fit < segments.len() {
+        let dropped: Vec<String> = segments[fit..].iter().map(|s| s.text.clone()).collect();
         notes.push(format!(
-            "a plan has at most {MAX_SEGMENTS} segments; left out: {}",
+            "a plan lasts at most {MAX_PLAN_SECONDS} s; left out: {}",
             dropped.join("; ")
         ));
-        segments.truncate(MAX_SEGMENTS);
+        segments.truncate(fit);
     }
     Plan {
         prompt: prompt.to_string(),
@@ -214,6 +298,17 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         segments,
         planner: PlannerKind::Offline,
         notes,
+    }
+}
+
+/// Names in a note each phrase of a clause about a limb in which no movement was read
+/// (`named`: the words that named one).
+fn note_limb_phrases(words: &[&str], named: &[usize], notes: &mut Vec<String>) {
+    for (phrase, limb) in accounting::limb_phrases_without_movement(words, named) {
+        notes.push(format!(
+            "\"{phrase}\" {NOT_PLACED}: the built-in planner has no rule for this movement \
+             of the {limb}"
+        ));
     }
 }
 
@@ -233,6 +328,25 @@ struct Movements {
     gestures: Vec<Action>,
     /// The index of the word that names the base.
     at: usize,
+    /// What else the clause names, with the index of its word, that the base and gestures do
+    /// not make: a second whole-body movement, a gesture on an arm already busy. The
+    /// planner places or names each ([`accounting`]).
+    left: Vec<(usize, Action)>,
+    /// The indices of every word that named a movement, made or left.
+    named: Vec<usize>,
+}
+
+impl Movements {
+    /// One action alone, named nowhere in particular (a substitute, a fallback).
+    fn only(base: Action) -> Movements {
+        Movements {
+            base,
+            gestures: Vec::new(),
+            at: 0,
+            left: Vec::new(),
+            named: Vec::new(),
+        }
+    }
 }
 
 /// What reading a clause depends on besides its words.
@@ -581,12 +695,9 @@ fn movements(words: &[&str], previous: Option<Action>, reader: Reader) -> Option
     if actions.is_empty() {
         let side = words.iter().find_map(|w| side_word(w))?;
         let previous = previous.filter(|a| a.is_gesture())?;
-        return Some(Movements {
-            base: previous.with_side(side),
-            gestures: Vec::new(),
-            at: 0,
-        });
+        return Some(Movements::only(previous.with_side(side)));
     }
+    let named = actions.iter().map(|(i, _)| *i).collect();
     // A walk turning and walking is one turn.
     if let Some(turn) = actions.iter().position(|(_, a)| {
         matches!(
@@ -604,11 +715,13 @@ fn movements(words: &[&str], previous: Option<Action>, reader: Reader) -> Option
     let base = actions[base_index].1;
     let mut used: Vec<BodyPart> = base.arms().to_vec();
     let mut gestures = Vec::new();
-    for (k, (_, a)) in actions.iter().enumerate() {
-        if k == base_index || !a.is_gesture() {
+    let mut left = Vec::new();
+    for (k, (i, a)) in actions.iter().enumerate() {
+        if k == base_index {
             continue;
         }
-        if a.arms().iter().any(|p| used.contains(p)) {
+        if !a.is_gesture() || a.arms().iter().any(|p| used.contains(p)) {
+            left.push((*i, *a));
             continue;
         }
         used.extend_from_slice(a.arms());
@@ -618,6 +731,8 @@ fn movements(words: &[&str], previous: Option<Action>, reader: Reader) -> Option
         base,
         gestures,
         at: actions[base_index].0,
+        left,
+        named,
     })
 }
 

@@ -473,6 +473,9 @@ pub struct PostureClause {
     /// The segment is the model's motion with postures held on some parts (a walk with the
     /// arms in a T), not a posture segment.
     pub over_model: bool,
+    /// The indices of the clause's words that named what the segment makes: the library's
+    /// postures and movements, and the model's actions.
+    pub named: Vec<usize>,
 }
 
 /// The segment for a clause that names postures or movements of the library, or `None` when
@@ -516,6 +519,7 @@ pub fn plan_clause(
     if mentions.is_empty() {
         return None;
     }
+    let named = named_words(words, &mentions);
     let mut notes = Vec::new();
     let postures: Vec<&NamedPosture> = mentions
         .iter()
@@ -566,6 +570,7 @@ pub fn plan_clause(
             segment,
             notes,
             over_model: true,
+            named,
         });
     }
 
@@ -653,7 +658,28 @@ pub fn plan_clause(
         segment,
         notes,
         over_model: false,
+        named,
     })
+}
+
+/// The indices of `words` inside a library mention (byte ranges of the words joined by
+/// spaces) or naming an action of the model's lexicon.
+fn named_words(words: &[&str], mentions: &[(std::ops::Range<usize>, Named)]) -> Vec<usize> {
+    let mut start = 0;
+    let mut out = Vec::new();
+    for (i, w) in words.iter().enumerate() {
+        let range = start..start + w.len();
+        start = range.end + 1;
+        let next = &words[i + 1..];
+        let prev: Vec<&str> = words[..i].iter().rev().copied().collect();
+        let in_mention = mentions
+            .iter()
+            .any(|(r, _)| r.start < range.end && range.start < r.end);
+        if in_mention || lexicon::action_word(w, next, &prev).is_some() {
+            out.push(i);
+        }
+    }
+    out
 }
 
 /// Nouns prompts use for the person ("the girl", "an athlete"): dropped from a segment's text.

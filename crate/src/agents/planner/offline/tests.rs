@@ -154,19 +154,32 @@ fn durations_are_read_and_clamped() {
 }
 
 #[test]
-fn repetitions_repeat_and_the_plan_stops_at_four_segments() {
+fn repetitions_repeat_and_the_plan_stops_at_sixty_seconds() {
     assert_eq!(plan("a person bows twice", None).segments.len(), 2);
     assert_eq!(plan("a person kicks three times", None).segments.len(), 3);
-    let long = plan(
+    let six = plan(
         "a person walks, then runs, then bows, then kicks, then punches, then dances",
         None,
     );
-    assert_eq!(long.segments.len(), 4);
-    assert!(
-        long.notes.iter().any(|n| n.contains("at most 4")),
-        "{:?}",
-        long.notes
-    );
+    assert_eq!(six.segments.len(), 6, "{:?}", six.notes);
+    assert!(six.seconds() <= MAX_PLAN_SECONDS);
+    // Twenty-four clauses of about 3 s each are more than a plan lasts: the ones that do not
+    // fit are named in a note, none dropped silently.
+    let clauses = ["walks forward", "bows", "waves the left hand"];
+    let prompt = (0..24)
+        .map(|i| format!("a person {}", clauses[i % 3]))
+        .collect::<Vec<_>>()
+        .join(", then ");
+    let long = plan(&prompt, None);
+    assert!(long.seconds() <= MAX_PLAN_SECONDS && long.seconds() > 50.0);
+    let note = long
+        .notes
+        .iter()
+        .find(|n| n.contains("at most 60 s; left out:"))
+        .unwrap_or_else(|| panic!("{:?}", long.notes));
+    // "…at most 60 s; left out: a; b; c": one "; " before each segment named.
+    let left_out = note.matches("; ").count();
+    assert_eq!(long.segments.len() + left_out, 24, "{note}");
 }
 
 #[test]
@@ -514,9 +527,11 @@ fn dataset_actions_are_the_models_when_its_vocabulary_lists_them() {
         Trajectory::from_text("circle clockwise")
     );
 
-    let many = plan_for("a person does ten squats", Some(&v2), None);
+    let ten = plan_for("a person does ten squats", Some(&v2), None);
+    assert_eq!(bases(&ten), ["a person does a squat"; 10]);
+    let many = plan_for("a person does 40 squats", Some(&v2), None);
     assert_eq!(bases(&many), ["a person does a squat"; MAX_SEGMENTS]);
-    assert!(many.notes.iter().any(|n| n.contains("asks for 10")));
+    assert!(many.notes.iter().any(|n| n.contains("asks for 40")));
 }
 
 #[test]

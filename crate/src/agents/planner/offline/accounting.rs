@@ -1,0 +1,162 @@
+//! Every clause accounted for: what a clause names that the built-in planner's rules do not
+//! make is found here, so the planner either places it (a second whole-body movement the
+//! clause moves on to) or names it in a note with the reason, and never drops it silently.
+//!
+//! The rules read a clause as one whole-body movement with gestures riding on it; what falls
+//! outside that reading is
+//! - a second whole-body movement ("picks up speed from a walk **to a run**"): placed after
+//!   the first when the words between say one follows the other, named in a note when they
+//!   happen at once (one whole-body motion at a time);
+//! - a gesture on an arm another gesture already moves ("waves the right hand while pointing
+//!   with it"): named in a note;
+//! - a phrase about an arm, a hand, a leg or a foot in which the rules found no movement at
+//!   all ("spins with **his right arm upwards**"): named in a note.
+
+use super::super::lexicon;
+
+/// Words that end a phrase inside a clause.
+const BOUNDARIES: &[&str] = &[",", "and", "while", "whilst", "then", "as", "but"];
+
+/// Words that open a phrase riding on the clause's movement ("holding both hands up").
+const OPENERS: &[&str] = &[
+    "with", "holding", "keeping", "having", "using", "while", "whilst",
+];
+
+/// Words between two movements of one clause that put the second after the first.
+const SEQUENCE_WORDS: &[&str] = &[
+    "to", "into", "then", "until", "before", "after", "becoming", "turning",
+];
+
+/// Limb nouns and the limb they name, for the notes.
+fn limb(word: &str) -> Option<&'static str> {
+    Some(match word {
+        "arm" | "arms" | "hand" | "hands" | "fist" | "fists" | "elbow" | "elbows" | "palm"
+        | "palms" | "finger" | "fingers" | "wrist" | "wrists" => "arm",
+        "leg" | "legs" | "foot" | "feet" | "knee" | "knees" | "toe" | "toes" | "heel" | "heels"
+        | "ankle" | "ankles" => "leg",
+        _ => return None,
+    })
+}
+
+/// Words that name no movement of their own in a limb phrase: determiners, pronouns, sides,
+/// the limbs themselves and the prepositions that attach them ("with his left hand").
+fn is_instrument_word(word: &str) -> bool {
+    lexicon::is_subject_word(word)
+        || limb(word).is_some()
+        || matches!(
+            word,
+            "with"
+                | "using"
+                | "by"
+                | "his"
+                | "her"
+                | "their"
+                | "its"
+                | "one"
+                | "left"
+                | "right"
+                | "both"
+                | "each"
+                | "other"
+                | "of"
+        )
+}
+
+/// The phrase that starts at word `at`: up to the next boundary, at most eight words.
+pub(super) fn phrase_from(words: &[&str], at: usize) -> String {
+    let end = (at + 1..words.len())
+        .find(|&k| BOUNDARIES.contains(&words[k]))
+        .unwrap_or(words.len())
+        .min(at + 8);
+    words[at.min(words.len())..end].join(" ")
+}
+
+/// Whether the words between the movement named at `first` and the one at `second` put the
+/// second after the first ("from a walk to a run", "walks until he breaks into a run").
+pub(super) fn in_sequence(words: &[&str], first: usize, second: usize) -> bool {
+    let (a, b) = (first.min(second), first.max(second));
+    words[a + 1..b].iter().any(|w| SEQUENCE_WORDS.contains(w))
+        && !words[a + 1..b]
+            .iter()
+            .any(|w| matches!(*w, "while" | "whilst" | "as"))
+}
+
+/// The phrases of a clause about a limb in which no movement was found: the words from the
+/// phrase's start (the clause's start, a boundary or an opener such as "holding") to its end,
+/// with the limb they name. `found` are the indices of the words that named a movement the
+/// rules read (placed or not). A phrase that only says which limb does a movement named
+/// before it ("kicks with the right leg") is not one.
+pub(super) fn limb_phrases_without_movement(
+    words: &[&str],
+    found: &[usize],
+) -> Vec<(String, &'static str)> {
+    let mut out: Vec<(String, &'static str)> = Vec::new();
+    let mut covered_to = 0;
+    for (i, w) in words.iter().enumerate() {
+        let Some(limb) = limb(w) else { continue };
+        if i < covered_to {
+            continue;
+        }
+        let start = (0..i)
+            .rev()
+            .find(|&k| BOUNDARIES.contains(&words[k]) || OPENERS.contains(&words[k]))
+            .map_or(0, |k| {
+                if BOUNDARIES.contains(&words[k]) {
+                    k + 1
+                } else {
+                    k
+                }
+            });
+        let end = (i + 1..words.len())
+            .find(|&k| BOUNDARIES.contains(&words[k]) || OPENERS.contains(&words[k]))
+            .unwrap_or(words.len());
+        covered_to = end;
+        if found.iter().any(|k| (start..end).contains(k)) {
+            continue;
+        }
+        let phrase = &words[start..end];
+        if phrase.iter().all(|w| is_instrument_word(w)) && found.iter().any(|k| *k < start) {
+            continue;
+        }
+        out.push((phrase.join(" "), limb));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn words(text: &str) -> Vec<&str> {
+        text.split(' ').collect()
+    }
+
+    #[test]
+    fn a_limb_phrase_without_a_movement_is_found_and_an_instrument_is_not() {
+        let w = words("he spins while having his right arm upwards");
+        assert_eq!(
+            limb_phrases_without_movement(&w, &[1]),
+            [("having his right arm upwards".to_string(), "arm")]
+        );
+        let w = words("a person kicks with the right leg");
+        assert!(limb_phrases_without_movement(&w, &[2]).is_empty());
+        // A movement found inside the phrase places it.
+        let w = words("a person walks with both arms raised");
+        assert!(limb_phrases_without_movement(&w, &[2, 6]).is_empty());
+        let w = words("the child hops , arms flapping like wings");
+        assert_eq!(
+            limb_phrases_without_movement(&w, &[2]),
+            [("arms flapping like wings".to_string(), "arm")]
+        );
+    }
+
+    #[test]
+    fn sequence_words_put_the_second_movement_after_the_first() {
+        let w = words("a woman picks up speed from a walk to a run");
+        assert!(in_sequence(&w, 7, 10));
+        let w = words("a person dances while walking");
+        assert!(!in_sequence(&w, 2, 4));
+        assert_eq!(phrase_from(&w, 4), "walking");
+        assert_eq!(phrase_from(&words("to a run , holding"), 0), "to a run");
+    }
+}

@@ -1,0 +1,216 @@
+//! Words of a prompt that say where, when or why a person moves, not how: "at the airport",
+//! "during the national anthem", "to protest a verdict", "feeling tired after the marathon".
+//! The motion model has nothing to make of them, and a planner that maps them onto the
+//! nearest movement adds one nobody asked for; the built-in planner drops them with a note
+//! that names them and says what they are.
+
+use super::super::lexicon;
+
+/// What a piece of context says instead of a movement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Context {
+    /// Where or when ("at the birthday party", "in the rain", "during the anthem").
+    Setting,
+    /// Why ("to greet the guests", "because he sees his friend").
+    Reason,
+    /// What the person feels or notices ("feeling tired", "hearing a loud noise").
+    State,
+}
+
+impl Context {
+    /// The note's words for it.
+    pub(super) fn describe(self) -> &'static str {
+        match self {
+            Context::Setting => "says where or when, not how the body moves",
+            Context::Reason => "says why, not how the body moves",
+            Context::State => "says what the person feels or notices, not how the body moves",
+        }
+    }
+}
+
+/// Prepositions that open a setting at the start of a clause.
+const SETTING_WORDS: &[&str] = &[
+    "at", "in", "on", "during", "inside", "outside", "under", "near", "beside",
+];
+
+/// Participles of verbs that are no movement: a clause opened by one says what the person
+/// feels, notices or has been through.
+const STATE_PARTICIPLES: &[&str] = &[
+    "feeling",
+    "hearing",
+    "seeing",
+    "noticing",
+    "realizing",
+    "realising",
+    "losing",
+    "winning",
+    "being",
+    "thinking",
+    "remembering",
+    "watching",
+    "sensing",
+    "wanting",
+];
+
+/// Words after "to" that make it a destination or a change ("to the door", "to a run", "to
+/// one knee", "to the left"), not a purpose.
+fn is_destination_word(word: &str) -> bool {
+    lexicon::is_subject_word(word)
+        || lexicon::number(word).is_some()
+        || matches!(
+            word,
+            "his"
+                | "her"
+                | "their"
+                | "its"
+                | "my"
+                | "your"
+                | "one"
+                | "both"
+                | "each"
+                | "left"
+                | "right"
+                | "front"
+                | "side"
+                | "sides"
+                | "back"
+                | "ground"
+                | "floor"
+                | "standing"
+                | "stand"
+                | "sit"
+                | "kneel"
+                | "rest"
+                | "halt"
+                | "stop"
+                | "him"
+                | "them"
+                | "me"
+                | "us"
+                | "itself"
+                | "himself"
+                | "herself"
+                | "themselves"
+        )
+}
+
+/// Verbs after "to" that are the movement itself ("crouches to set something down",
+/// "lowers the body to lie flat"), as the training captions say it, not a reason for it.
+const MOVEMENT_INFINITIVES: &[&str] = &[
+    "lie", "lay", "set", "put", "place", "pick", "sit", "kneel", "squat", "crouch", "touch",
+    "reach", "bend", "lean", "step", "walk", "run", "jump", "turn", "spin", "look", "bow",
+];
+
+/// Limb nouns after "to": the body part a movement goes to ("elbow to knee").
+const LIMBS: &[&str] = &[
+    "knee",
+    "knees",
+    "toe",
+    "toes",
+    "foot",
+    "feet",
+    "chest",
+    "head",
+    "hip",
+    "hips",
+    "shoulder",
+    "shoulders",
+    "waist",
+    "elbow",
+    "ear",
+    "mouth",
+    "face",
+];
+
+/// Whether `words[i]` is "to" opening a purpose ("to greet", "in order to"), not a
+/// destination, a body part or a movement.
+fn purpose_at(words: &[&str], i: usize) -> bool {
+    words[i] == "to"
+        && words.get(i + 1).is_some_and(|next| {
+            !is_destination_word(next)
+                && !MOVEMENT_INFINITIVES.contains(next)
+                && !LIMBS.contains(next)
+                && !next.ends_with("ing")
+                && !next.ends_with("ed")
+                // A plural noun ("signals to cars"): a verb's bare form seldom ends in one s.
+                && !(next.ends_with('s') && !next.ends_with("ss"))
+                && !matches!(*next, "music" | "rhythm" | "himself" | "herself")
+        })
+}
+
+/// What a whole clause is, when it is context and no movement.
+pub(super) fn whole_clause(words: &[&str], names_movement: bool) -> Option<Context> {
+    let first = *words.first()?;
+    if purpose_at(words, 0) || matches!(words, ["in", "order", "to", ..] | ["so", "as", "to", ..]) {
+        // "To celebrate the goal, …": whatever its verb, a clause that opens with a purpose
+        // gives the reason for the clause it is attached to.
+        return Some(Context::Reason);
+    }
+    if first == "because" || (first == "since" && words.len() > 2) {
+        return Some(Context::Reason);
+    }
+    if STATE_PARTICIPLES.contains(&first) {
+        return Some(Context::State);
+    }
+    if SETTING_WORDS.contains(&first) && !names_movement {
+        return Some(Context::Setting);
+    }
+    None
+}
+
+/// Where a purpose or a reason starts inside a clause that moves ("bows to greet the
+/// guests", "waves because he sees his friend"), if one does, after the first word.
+pub(super) fn reason_tail(words: &[&str]) -> Option<usize> {
+    (1..words.len()).find(|&i| {
+        purpose_at(words, i)
+            || words[i] == "because"
+            || (words[i] == "in" && words[i + 1..].starts_with(&["order", "to"]))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn words(text: &str) -> Vec<&str> {
+        text.split(' ').collect()
+    }
+
+    #[test]
+    fn settings_reasons_and_states_are_context_and_destinations_are_not() {
+        let whole = |t: &str, moves| whole_clause(&words(t), moves);
+        assert_eq!(
+            whole("at the birthday party", false),
+            Some(Context::Setting)
+        );
+        assert_eq!(whole("in the rain", false), Some(Context::Setting));
+        assert_eq!(whole("in a circle", true), None);
+        assert_eq!(whole("to celebrate the goal", false), Some(Context::Reason));
+        assert_eq!(whole("to show the way", true), Some(Context::Reason));
+        assert_eq!(
+            whole("feeling tired after the marathon", false),
+            Some(Context::State)
+        );
+        assert_eq!(whole("a man bows", true), None);
+        let tail = |t: &str| reason_tail(&words(t));
+        assert_eq!(tail("a man stomps his feet to protest a verdict"), Some(5));
+        assert_eq!(tail("a woman jogs along the beach to stay fit"), Some(6));
+        assert_eq!(tail("a man waves because he sees his friend"), Some(3));
+        for moving in [
+            "a person walks to the door",
+            "picks up speed from a walk to a run",
+            "drops to one knee",
+            "turns to the left",
+            "turns to face the crowd",
+            "sits down to rest",
+            "comes to a stop",
+            "a person does elbow to knee exercises",
+            "the person crouches to set something down with the left hand",
+            "a person lowers the body to lie flat on the floor",
+            "a person signals to cars with the arms like a traffic officer",
+            "someone dances to music",
+        ] {
+            assert_eq!(tail(moving), None, "{moving}");
+        }
+    }
+}
