@@ -124,6 +124,9 @@ async function open(context, url) {
 async function describe(opened) {
   const seen = await opened.page.evaluate(() => ({
     status: document.querySelector("#status")?.textContent,
+    // The stage of a long step ("downloading the model: base.bpk received"), which says
+    // where a load that never ends stopped.
+    progress: document.querySelector(".status .progress")?.textContent,
     hash: document.querySelector(".viewer")?.dataset.jointsHash,
     busy: document.querySelector("#generate")?.disabled,
     viewer: document.querySelector(".viewer-problem")?.textContent,

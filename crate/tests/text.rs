@@ -391,11 +391,11 @@ fn convert_minilm_into_static_models() {
 
 // ---- the timeline scorer's meaning match (`coma::agents::planner::timeline_set`) ----
 
-/// The threshold at which the timeline scorer calls a clause and a plan text the same movement
-/// is the one the hand-labelled pairs calibrate with the shipped encoder.
+/// The threshold at which the planner and the timeline scorer call a clause and a plan text
+/// the same movement is the one the hand-labelled pairs calibrate with the shipped encoder.
 #[test]
-fn timeline_scorer_threshold_is_calibrated_on_the_labelled_pairs() {
-    use coma::agents::planner::timeline_set::{
+fn same_movement_threshold_is_calibrated_on_the_labelled_pairs() {
+    use coma::agents::planner::meaning::{
         calibrate, embedding_similarity, load_pairs, SAME_MOVEMENT_MIN_SIMILARITY,
     };
     let pairs =
@@ -415,5 +415,62 @@ fn timeline_scorer_threshold_is_calibrated_on_the_labelled_pairs() {
         cal.smoothed_accuracy >= 0.85,
         "{:.3}",
         cal.smoothed_accuracy
+    );
+}
+
+/// With the shipped sentence encoder, the built-in planner finds by meaning what its rules do
+/// not name: a library posture ("sits" is "sit on a chair"), the gesture an arm phrase means,
+/// on its own side; and it never stands in a movement of the opposite direction.
+#[test]
+fn the_planner_places_movements_by_meaning_and_keeps_sides_and_directions() {
+    use coma::agents::planner::offline;
+    let embed = |s: &str| encoder().encode(&[s])[0].to_vec();
+    let sits = offline::plan(
+        "A man walks calmly with his right hand raised, and then sits.",
+        Some(&embed),
+    );
+    let track = sits.segments[1]
+        .postures
+        .as_ref()
+        .unwrap_or_else(|| panic!("{sits:#?}"));
+    assert_eq!(track.keys[0].script.name.as_deref(), Some("sit on a chair"));
+
+    let raised = offline::plan(
+        "A person walks backwards holding both hands above the head.",
+        Some(&embed),
+    );
+    let s = &raised.segments[0];
+    assert_eq!(s.base, "a person walks backward");
+    assert!(
+        s.parts
+            .left_arm
+            .as_deref()
+            .is_some_and(|t| t.contains("raises"))
+            && s.parts
+                .right_arm
+                .as_deref()
+                .is_some_and(|t| t.contains("raises")),
+        "{raised:#?}"
+    );
+
+    let lowers = offline::plan(
+        "A girl raises her right arm and then lowers it.",
+        Some(&embed),
+    );
+    assert!(
+        lowers
+            .segments
+            .iter()
+            .skip(1)
+            .all(|s| !s.text.contains("up") && !s.text.contains("raise")),
+        "{lowers:#?}"
+    );
+    let reaches = offline::plan(
+        "A person sits on the floor, then reaches forward with their right arm.",
+        Some(&embed),
+    );
+    assert!(
+        reaches.segments.iter().all(|s| !s.text.contains("left")),
+        "{reaches:#?}"
     );
 }

@@ -877,6 +877,46 @@ pub fn is_finite_verb(word: &str) -> bool {
         )
 }
 
+/// Nouns prompts use for the person ("the girl", "an athlete"): dropped from a segment's text.
+pub fn is_subject_noun(word: &str) -> bool {
+    matches!(
+        word,
+        "man"
+            | "woman"
+            | "girl"
+            | "boy"
+            | "child"
+            | "kid"
+            | "person"
+            | "someone"
+            | "athlete"
+            | "dancer"
+            | "player"
+            | "student"
+            | "soldier"
+            | "monk"
+            | "runner"
+            | "referee"
+            | "gymnast"
+            | "hiker"
+            | "fan"
+            | "winner"
+            | "singer"
+            | "model"
+            | "climber"
+            | "bodybuilder"
+            | "cheerleader"
+            | "goalkeeper"
+            | "people"
+            | "guy"
+            | "lady"
+            | "his"
+            | "her"
+            | "old"
+            | "young"
+    )
+}
+
 /// Words a clause may start with before its verb ("the speaker", "they", "he then").
 pub fn is_subject_word(word: &str) -> bool {
     matches!(

@@ -7,6 +7,7 @@
 
 pub mod lexicon;
 pub mod llm;
+pub mod meaning;
 pub mod offline;
 pub mod postures;
 pub mod prompt_set;

@@ -2,42 +2,53 @@
 //!
 //! 1. The prompt is cut into clauses at sentence ends and temporal connectives ("then",
 //!    "after that", "finally", "before", "after", a comma or "and" that starts a new verb);
-//!    "while" joins two clauses into one. "Before Y, X" and "X after Y" are put in time order.
+//!    "while" joins two clauses into one, and so does a comma before "holding", "keeping" or
+//!    "with" (what the body keeps doing rides on the clause). "Before Y, X" and "X after Y"
+//!    are put in time order. Context that is no movement (where, when, why, what the person
+//!    feels) is dropped with a note (the `context` module).
 //! 2. Each clause gets its movements from [`lexicon`]: one whole-body or walking motion as the
 //!    base, and arm gestures beside it as part edits ("walks forward waving the left hand").
-//!    A clause with no verb inherits the previous clause's gesture ("then the left hand").
+//!    A clause with no verb inherits the previous clause's gesture ("then the left hand"); a
+//!    clause that lowers "it" brings down the arms raised before (the `anaphora` module).
 //! 3. Repetitions ("twice") repeat the clause; durations come from "for N seconds", the
 //!    action's usual length and tempo words; paths ("in a circle clockwise") from the
 //!    trajectory shape library; style words ("angry", "elderly") become the caption phrases
 //!    the data uses.
-//! 4. A clause with no known movement is mapped to the nearest training action by sentence
-//!    similarity when an embedder is given, and dropped otherwise, with a note either way.
+//! 4. A clause with no known movement is mapped, when an embedder is given, onto the training
+//!    action or the library posture that means the same movement ([`meaning`]: calibrated
+//!    threshold, same side, never the opposite direction), and an arm phrase onto the gesture
+//!    or arm posture it means (the `limbs` module); otherwise it is named in a note.
+//! 5. Whatever a clause names that no segment makes is named in a note with the reason
+//!    (the `accounting` module): no clause disappears silently. A plan lasts up to
+//!    [`MAX_PLAN_SECONDS`]; clauses past it are named in a note.
 //!
 //! The actions of dataset v2 (squat, jump, lie down, kicks, throw, …) are planned as the
 //! model's own motion only when the model's vocabulary lists them ([`plan_for`]); otherwise,
 //! and for poses held ("holds a deep squat"), the posture library makes what it can of them.
 
 use super::lexicon::{self, Action, Direction, Repertoire, Side};
+use super::meaning::{self, Matcher};
 use super::postures;
 use crate::dataset::Vocabulary;
 use crate::plan::{
     clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_PLAN_SECONDS, MAX_SEGMENTS,
     MAX_TEXT_CHARS,
 };
+use crate::posture::library::Library;
+use crate::posture::track::PostureTrack;
 use crate::skeleton::BodyPart;
 use crate::trajectory::{Shape, Trajectory};
 
 mod accounting;
+mod anaphora;
 mod context;
+mod limbs;
 
 use context::Context;
 
 /// Turns a sentence into a unit embedding (MiniLM); the planner uses it to map movements it
 /// has no rule for onto the nearest action of the training data.
 pub type Embedder<'a> = &'a dyn Fn(&str) -> Vec<f32>;
-
-/// Lowest cosine similarity at which an unknown clause is mapped onto a training action.
-pub const NEAREST_MIN_SIMILARITY: f32 = 0.35;
 
 /// How a note says a clause was planned as a different movement than it asks for.
 pub const SUBSTITUTED: &str = "is not a movement the model knows";
@@ -67,6 +78,11 @@ pub fn plan(prompt: &str, embed: Option<Embedder>) -> Plan {
 /// [`MAX_SEGMENTS`] segments, [`MAX_PLAN_SECONDS`] at most.
 pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Embedder>) -> Plan {
     let known = Repertoire::new(vocabulary);
+    // One judgement of "the same movement" for the whole prompt, each text embedded once.
+    let similarity = embed.map(meaning::embedding_similarity);
+    let matcher = similarity
+        .as_ref()
+        .map(|s| Matcher::new(s, meaning::SAME_MOVEMENT_MIN_SIMILARITY));
     let mut notes = Vec::new();
     let mut text: String = prompt.chars().take(MAX_PROMPT_CHARS).collect();
     if prompt.chars().count() > MAX_PROMPT_CHARS {
@@ -81,36 +97,7 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     // The dataset v2 action the last segment made, whose clip ends standing again.
     let mut ends_standing: Option<Action> = None;
     let clauses = clauses(&text, known);
-    let mut read: Vec<Vec<&str>> = Vec::new();
-    for clause in &clauses {
-        let words: Vec<&str> = clause.iter().map(String::as_str).collect();
-        let names_movement = movements(&words, None, Reader::alone(known)).is_some()
-            || postures::names_posture(&words)
-            || path(&words).is_some();
-        if let Some(context) = context::whole_clause(&words, names_movement) {
-            notes.push(format!(
-                "\"{}\" {}; dropped",
-                words.join(" "),
-                context.describe()
-            ));
-            continue;
-        }
-        // "waves the arms to direct traffic" names an action of the data, not a reason.
-        let names_action =
-            |from: usize| (from..words.len()).any(|k| lexicon::dataset_action(&words, k).is_some());
-        match context::reason_tail(&words).filter(|&i| !names_action(i)) {
-            Some(i) => {
-                notes.push(format!(
-                    "\"{}\" {}; dropped",
-                    words[i..].join(" "),
-                    Context::Reason.describe()
-                ));
-                read.push(words[..i].to_vec());
-            }
-            None => read.push(words),
-        }
-    }
-    let clauses = read;
+    let clauses = without_context(&clauses, known, &mut notes);
     let readers: Vec<Reader> = (0..clauses.len())
         .map(|k| Reader {
             known,
@@ -122,6 +109,7 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     for (k, words) in clauses.iter().enumerate() {
         let words = words.as_slice();
         let reader = readers[k];
+        let clause_start = segments.len();
         let only_stands_up =
             || postures::stands_up(words) && movements(words, None, reader).is_none();
         if let Some(action) = ends_standing.filter(|_| only_stands_up()) {
@@ -161,7 +149,6 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         let model_parts = model.as_ref().map(|m| (m.base, m.gestures.as_slice()));
         if let Some(planned) = postures::plan_clause(words, model_parts, &model_segment) {
             notes.extend(planned.notes);
-            note_limb_phrases(words, &planned.named, &mut notes);
             postures::land_in(words, segments.last_mut(), &planned.segment);
             previous = None;
             ends_standing = None;
@@ -177,6 +164,18 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             for _ in 0..times {
                 segments.push(planned.segment.clone());
             }
+            if let Some(found) = model.as_ref().filter(|_| planned.over_model) {
+                // "from a walk to a run, holding the T-pose": the run holds it too.
+                let held = model_segment();
+                for (_, mut next) in moves_on(words, found, style.as_deref(), &mut notes) {
+                    next.text = planned.segment.text.replacen(&held.text, &next.text, 1);
+                    next.postures = planned.segment.postures.clone();
+                    next.parts = planned.segment.parts.clone();
+                    segments.push(next);
+                }
+            }
+            let made = &mut segments[clause_start..];
+            place_limb_phrases(words, &planned.named, matcher.as_ref(), made, &mut notes);
             continue;
         }
         if let (None, Some(stay)) = (&model, postures::stay(words)) {
@@ -203,9 +202,42 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             }
             continue;
         }
+        if let Some(lowered) = model
+            .is_none()
+            .then(|| lowered_back(words, segments.last()))
+            .flatten()
+        {
+            segments.push(lowered);
+            previous = None;
+            continue;
+        }
+        let action = model
+            .is_none()
+            .then(|| nearest_action(words, matcher.as_ref(), known));
+        if let Some((name, similarity)) = model
+            .is_none()
+            .then(|| nearest_library_entry(words, matcher.as_ref()))
+            .flatten()
+            .filter(|(_, s)| action.flatten().is_none_or(|(_, a)| *s > a))
+        {
+            // "sits" is the library's "sit on a chair": planned as if the clause named it.
+            let named: Vec<&str> = name.split(' ').collect();
+            if let Some(planned) = postures::plan_clause(&named, None, &model_segment) {
+                notes.push(format!(
+                    "\"{}\" {SUBSTITUTED}; used the posture library's \"{name}\" \
+                     (similarity {similarity:.2})",
+                    words.join(" ")
+                ));
+                notes.extend(planned.notes);
+                segments.push(planned.segment);
+                previous = None;
+                ends_standing = None;
+                continue;
+            }
+        }
         let found = match model {
             Some(found) => found,
-            None => match nearest_action(words, embed, known) {
+            None => match action.flatten() {
                 Some((action, similarity)) => {
                     notes.push(format!(
                         "\"{}\" {SUBSTITUTED}; used the nearest one, \"{}\" \
@@ -228,34 +260,14 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             segments.push(made.clone());
         }
         let mut last = found.base;
-        for &(at, action) in &found.left {
-            if !action.is_gesture() && accounting::in_sequence(words, found.at, at) {
-                // "from a walk to a run": the clause moves on to it, carrying its gestures.
-                let next = Movements {
-                    base: action,
-                    gestures: found.gestures.clone(),
-                    at,
-                    left: Vec::new(),
-                    named: Vec::new(),
-                };
-                segments.push(segment(words, &next, style.as_deref()));
-                last = action;
-                continue;
-            }
-            let why = if action.is_gesture() {
-                "the arm it needs already does another movement in this clause"
-            } else {
-                "it happens at the same time as another whole-body movement of this clause, \
-                 and the body makes one at a time"
-            };
-            notes.push(format!(
-                "\"{}\" {NOT_PLACED}: {why}",
-                accounting::phrase_from(words, at)
-            ));
+        for (action, next) in moves_on(words, &found, style.as_deref(), &mut notes) {
+            segments.push(next);
+            last = action;
         }
         // A substitute or an inherited gesture stands for the whole clause.
         if !found.named.is_empty() {
-            note_limb_phrases(words, &found.named, &mut notes);
+            let made = &mut segments[clause_start..];
+            place_limb_phrases(words, &found.named, matcher.as_ref(), made, &mut notes);
         }
         previous = Some(found.gestures.last().copied().unwrap_or(last));
         ends_standing = Some(last).filter(|a| a.label().is_some() && *a != Action::LieDown);
@@ -301,15 +313,186 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     }
 }
 
-/// Names in a note each phrase of a clause about a limb in which no movement was read
-/// (`named`: the words that named one).
-fn note_limb_phrases(words: &[&str], named: &[usize], notes: &mut Vec<String>) {
-    for (phrase, limb) in accounting::limb_phrases_without_movement(words, named) {
+/// The segment of a clause that lowers the arms the segment before raised ("raises her right
+/// arm and then lowers it"): the arms go down to the library's standing posture while the
+/// body stands; `None` when the clause is no such thing or nothing before was raised.
+fn lowered_back(words: &[&str], before: Option<&Segment>) -> Option<Segment> {
+    if !anaphora::lowers_back(words) {
+        return None;
+    }
+    let arms = anaphora::raised_arms(before?);
+    let stand = Library::builtin().get("stand")?;
+    let which = match arms.as_slice() {
+        [BodyPart::LeftArm] => "the left arm",
+        [BodyPart::RightArm] => "the right arm",
+        [] => return None,
+        _ => "both arms",
+    };
+    let mut script = stand.script.clone();
+    script.name = Some("arms down".into());
+    Some(Segment {
+        text: format!("a person lowers {which}"),
+        seconds: 2.0,
+        base: "a person stands still".into(),
+        parts: PartEdits::default(),
+        trajectory: None,
+        postures: Some(PostureTrack::holding(arms, script)),
+    })
+}
+
+/// The segments of the whole-body movements a clause moves on to after its first ("from a
+/// walk to a run"), each with the action it makes and carrying the clause's gestures; what
+/// else the clause names that its movement does not make is named in a note with the reason.
+fn moves_on(
+    words: &[&str],
+    found: &Movements,
+    style: Option<&str>,
+    notes: &mut Vec<String>,
+) -> Vec<(Action, Segment)> {
+    let mut out = Vec::new();
+    for &(at, action) in &found.left {
+        if !action.is_gesture() && accounting::in_sequence(words, found.at, at) {
+            let next = Movements {
+                base: action,
+                gestures: found.gestures.clone(),
+                at,
+                left: Vec::new(),
+                named: Vec::new(),
+            };
+            out.push((action, segment(words, &next, style)));
+            continue;
+        }
+        let why = if action.is_gesture() {
+            "the arm it needs already does another movement in this clause"
+        } else {
+            "it happens at the same time as another whole-body movement of this clause, and \
+             the body makes one at a time"
+        };
         notes.push(format!(
-            "\"{phrase}\" {NOT_PLACED}: the built-in planner has no rule for this movement \
-             of the {limb}"
+            "\"{}\" {NOT_PLACED}: {why}",
+            accounting::phrase_from(words, at)
         ));
     }
+    out
+}
+
+/// Places each phrase of a clause about an arm in which the rules read no movement on the
+/// clause's segments (`made`), as the gesture or arm posture it means ([`limbs`]), where
+/// those arms are free; names it in a note otherwise, and names every leg phrase (`named`:
+/// the words that named a movement).
+fn place_limb_phrases(
+    words: &[&str],
+    named: &[usize],
+    matcher: Option<&Matcher>,
+    made: &mut [Segment],
+    notes: &mut Vec<String>,
+) {
+    for (phrase, limb) in accounting::limb_phrases_without_movement(words, named) {
+        let phrase_words: Vec<&str> = phrase.split(' ').collect();
+        let found = matcher
+            .filter(|_| limb == "arm")
+            .and_then(|m| limbs::nearest_arm_movement(&phrase_words, m));
+        let Some((movement, similarity)) = found
+            .filter(|(m, _)| !made.is_empty() && made.iter().all(|s| arms_free(s, &m.parts())))
+        else {
+            notes.push(format!(
+                "\"{phrase}\" {NOT_PLACED}: the built-in planner has no rule for this \
+                 movement of the {limb}"
+            ));
+            continue;
+        };
+        for segment in made.iter_mut() {
+            match movement {
+                limbs::LimbMovement::Gesture(g) => {
+                    for part in g.arms() {
+                        segment.parts.set(*part, Some(g.caption()));
+                    }
+                }
+                limbs::LimbMovement::Posture(p) => {
+                    segment.postures =
+                        Some(PostureTrack::holding(p.parts.clone(), p.script.clone()));
+                }
+            }
+        }
+        notes.push(format!(
+            "\"{phrase}\" {SUBSTITUTED} on its own; used \"{}\" on the same arms \
+             (similarity {similarity:.2})",
+            movement.describe()
+        ));
+    }
+}
+
+/// Whether a segment leaves `arms` to a movement of their own: no instruction and no posture
+/// on them.
+fn arms_free(segment: &Segment, arms: &[BodyPart]) -> bool {
+    arms.iter().all(|a| segment.parts.get(*a).is_none()) && segment.postures.is_none()
+}
+
+/// The clauses with the context dropped ([`context`]): whole clauses that say where, when,
+/// why or what the person feels, the reasons at the end of a clause ("bows to greet the
+/// guests"), and a clause of no movement and no verb beside a dropped one ("feeling tired
+/// after the marathon" is cut at "after"); each named in a note.
+fn without_context<'a>(
+    clauses: &'a [Vec<String>],
+    known: Repertoire,
+    notes: &mut Vec<String>,
+) -> Vec<Vec<&'a str>> {
+    let clauses: Vec<Vec<&str>> = clauses
+        .iter()
+        .map(|c| c.iter().map(String::as_str).collect())
+        .collect();
+    let moves: Vec<bool> = clauses
+        .iter()
+        .map(|words| {
+            movements(words, None, Reader::alone(known)).is_some()
+                || postures::names_posture(words)
+                || path(words).is_some()
+        })
+        .collect();
+    let kinds: Vec<Option<Context>> = clauses
+        .iter()
+        .zip(&moves)
+        .map(|(words, moves)| context::whole_clause(words, *moves))
+        .collect();
+    let verbless = |k: usize| {
+        !moves[k]
+            && !clauses[k]
+                .iter()
+                .any(|w| lexicon::is_finite_verb(w) || postures::is_posture_verb(w))
+    };
+    let mut out = Vec::new();
+    for (k, words) in clauses.iter().enumerate() {
+        let beside = |j: Option<usize>| j.and_then(|j| kinds.get(j).copied().flatten());
+        let kind = kinds[k].or_else(|| {
+            verbless(k)
+                .then(|| beside(k.checked_sub(1)).or(beside(Some(k + 1))))
+                .flatten()
+        });
+        if let Some(context) = kind {
+            notes.push(format!(
+                "\"{}\" {}; dropped",
+                words.join(" "),
+                context.describe()
+            ));
+            continue;
+        }
+        // "waves the arms to direct traffic" names an action of the data, not a reason.
+        let names_action = |to: usize| {
+            (to + 1..(to + 3).min(words.len())).any(|k| lexicon::dataset_action(words, k).is_some())
+        };
+        match context::reason_tail(words).filter(|&i| !names_action(i)) {
+            Some(i) => {
+                notes.push(format!(
+                    "\"{}\" {}; dropped",
+                    words[i..].join(" "),
+                    Context::Reason.describe()
+                ));
+                out.push(words[..i].to_vec());
+            }
+            None => out.push(words.clone()),
+        }
+    }
+    out
 }
 
 /// The segments' texts as one description ("a person walks forward, then a person bows").
@@ -515,7 +698,22 @@ fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> 
                     .position(|t| !matches!(t.as_str(), "and" | "then" | "finally" | ","))
                     .unwrap_or(rest.len());
                 let connective = rest[..after].iter().any(|t| t == "then" || t == "finally");
-                if connective || starts_verb(&rest[after..], known) || starts_connective(rest) {
+                // "In the rain, a woman hurries …": a sentence that opens with context ends it
+                // at its first comma, whatever the verb after it.
+                let opening: Vec<&str> = sentence[..i].iter().map(String::as_str).collect();
+                let opening = chunks.len() == 1 && context::opens_context(&opening);
+                // "…, holding the T-pose": what the body keeps doing rides on the clause.
+                let rider =
+                    !connective && rest.first().is_some_and(|w| RIDERS.contains(&w.as_str()));
+                if rider {
+                    i += 1;
+                    continue;
+                }
+                if connective
+                    || opening
+                    || starts_verb(&rest[after..], known)
+                    || starts_connective(rest)
+                {
                     new_chunk(&mut chunks, Marker::None, false);
                 }
                 i += 1;
@@ -583,6 +781,10 @@ fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> 
     chunks.retain(|c| !c.words.is_empty());
     order(chunks, known)
 }
+
+/// Words that open a phrase of what the body keeps doing during a clause ("…, holding the
+/// T-pose", "…, with both arms raised"): after a comma they ride on the clause before.
+const RIDERS: &[&str] = &["holding", "keeping", "with"];
 
 fn starts_connective(rest: &[String]) -> bool {
     matches!(
@@ -788,8 +990,9 @@ fn side(words: &[&str], i: usize) -> Option<Side> {
         lexicon::action_word(w, &[], &[]).is_some_and(|a| !a.is_gesture())
             || matches!(w, "while" | "then" | "and")
     };
-    for w in words.iter().skip(i + 1).take(5) {
-        if stop(w) {
+    // Up to the end of the gesture's phrase: "waves to his friends with his left hand".
+    for w in words.iter().skip(i + 1).take(8) {
+        if stop(w) || lexicon::action_word(w, &[], &[]).is_some() {
             break;
         }
         if let Some(s) = side_word(w) {
@@ -842,10 +1045,10 @@ fn prompt_style(text: &str) -> Option<String> {
 /// A clause of no known movement mapped onto the nearest training action by similarity.
 fn nearest_action(
     words: &[&str],
-    embed: Option<Embedder>,
+    matcher: Option<&Matcher>,
     known: Repertoire,
 ) -> Option<(Action, f32)> {
-    let embed = embed?;
+    let matcher = matcher?;
     if words.is_empty()
         || !words
             .iter()
@@ -859,7 +1062,15 @@ fn nearest_action(
     {
         return None;
     }
-    let query = embed(&format!("a person {}", words.join(" ")));
+    let clause = format!("a person {}", without_subject(words).join(" "));
+    // A substitute must mean the same movement, as the calibrated judgement of
+    // [`meaning`] has it (sides aside, never the opposite direction or gait), and keep the
+    // side the clause names.
+    let side = words.iter().find_map(|w| match *w {
+        "left" => Some(Side::Left),
+        "right" => Some(Side::Right),
+        _ => None,
+    });
     // The sided front kicks, where the model knows them, stand for the Bandai kick (as
     // `dataset_action` reads "kicks").
     let sided_kicks = known.knows(Action::FrontKick(Side::Right));
@@ -867,9 +1078,54 @@ fn nearest_action(
         .iter()
         .filter(|a| !(sided_kicks && **a == Action::Kick))
         .chain(lexicon::DATASET_ACTIONS.iter().filter(|a| known.knows(**a)))
-        .map(|a| (*a, cosine(&query, &embed(&a.caption()))))
-        .filter(|(_, s)| *s >= NEAREST_MIN_SIMILARITY)
+        .map(|a| match side {
+            Some(side) => a.with_side(side),
+            None => *a,
+        })
+        .filter(|a| side.is_none_or(|side| !names_other_side(&a.caption(), side)))
+        .filter_map(|a| matcher.same(&clause, &a.caption()).map(|s| (a, s)))
         .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// A clause of no known movement mapped onto the posture or movement of the library whose
+/// name means the same movement ([`meaning`]), with the similarity: "sits" is "sit on a
+/// chair".
+fn nearest_library_entry(words: &[&str], matcher: Option<&Matcher>) -> Option<(String, f32)> {
+    let matcher = matcher?;
+    if words.is_empty()
+        || words
+            .iter()
+            .all(|w| NOT_MOVEMENT.contains(w) || is_filler(w))
+    {
+        return None;
+    }
+    let clause = format!("a person {}", without_subject(words).join(" "));
+    Library::builtin()
+        .all()
+        .filter_map(|n| matcher.same(&clause, n.name()).map(|s| (n.name(), s)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(name, s)| (name.to_string(), s))
+}
+
+/// A clause without the words that name the person ("a dancer spreads …" is "spreads …"):
+/// "dancer" would make any clause a dance.
+fn without_subject<'a>(words: &[&'a str]) -> Vec<&'a str> {
+    words
+        .iter()
+        .copied()
+        .skip_while(|w| lexicon::is_subject_word(w) || lexicon::is_subject_noun(w))
+        .collect()
+}
+
+/// Whether a caption names the side opposite to `side` and not `side` itself.
+fn names_other_side(caption: &str, side: Side) -> bool {
+    let words: Vec<&str> = caption.split(' ').collect();
+    let (own, other) = match side {
+        Side::Left => ("left", "right"),
+        Side::Right => ("right", "left"),
+        Side::Both => return false,
+    };
+    words.contains(&other) && !words.contains(&own)
 }
 
 /// Verbs of standing still or of no movement at all: a clause of only these is no segment.
@@ -923,13 +1179,6 @@ const TRAINING_ACTIONS: [Action; 16] = [
     Action::Goodbye,
     Action::Raise(Side::Both),
 ];
-
-fn cosine(a: &[f32], b: &[f32]) -> f32 {
-    let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
-    let na = a.iter().map(|x| x * x).sum::<f32>().sqrt();
-    let nb = b.iter().map(|x| x * x).sum::<f32>().sqrt();
-    dot / (na * nb).max(1e-9)
-}
 
 /// The segment of one clause.
 fn segment(words: &[&str], found: &Movements, style: Option<&str>) -> Segment {

@@ -234,7 +234,7 @@ fn held_in(words: &[&str], at: usize) -> bool {
 pub fn keeps_pose_before(words: &[&str]) -> bool {
     let first = words
         .iter()
-        .find(|w| !lexicon::is_subject_word(w) && !is_subject_noun(w));
+        .find(|w| !lexicon::is_subject_word(w) && !lexicon::is_subject_noun(w));
     match first {
         Some(&("land" | "lands")) => names_posture(words),
         // "holds it", "holds for 3 seconds"; not "holds a T-pose", a pose of its own.
@@ -334,7 +334,16 @@ pub fn stay(words: &[&str]) -> Option<Stay> {
         "stay",
     ];
     let has = |list: &[&str]| words.iter().any(|w| list.contains(w));
-    if has(HOLD) {
+    // "holds the pose", "holds it there": holding what there is, not an object.
+    let holds_it = words.windows(2).any(|w| {
+        matches!(w[0], "hold" | "holds" | "holding")
+            && matches!(w[1], "it" | "that" | "this" | "there" | "still" | "steady")
+    }) || words.windows(3).any(|w| {
+        matches!(w[0], "hold" | "holds" | "holding")
+            && matches!(w[1], "the" | "that" | "this" | "his" | "her" | "their")
+            && matches!(w[2], "pose" | "position" | "posture" | "stance")
+    });
+    if has(HOLD) || holds_it {
         Some(Stay::Hold)
     } else if has(LONGER) {
         Some(Stay::Longer)
@@ -355,7 +364,7 @@ pub fn hold_segment(words: &[&str], previous: &Segment) -> Option<Segment> {
     held.keys[0].transition = 0.3;
     let subject_free: Vec<&str> = words
         .iter()
-        .skip_while(|w| lexicon::is_subject_word(w) || is_subject_noun(w))
+        .skip_while(|w| lexicon::is_subject_word(w) || lexicon::is_subject_noun(w))
         .copied()
         .collect();
     Some(Segment {
@@ -643,7 +652,7 @@ pub fn plan_clause(
         clamp_seconds(track.natural_seconds() + DEFAULT_TRANSITION_SECONDS).unwrap_or(2.0);
     let subject_free: Vec<&str> = words
         .iter()
-        .skip_while(|w| lexicon::is_subject_word(w) || is_subject_noun(w))
+        .skip_while(|w| lexicon::is_subject_word(w) || lexicon::is_subject_noun(w))
         .copied()
         .collect();
     let segment = Segment {
@@ -680,46 +689,6 @@ fn named_words(words: &[&str], mentions: &[(std::ops::Range<usize>, Named)]) -> 
         }
     }
     out
-}
-
-/// Nouns prompts use for the person ("the girl", "an athlete"): dropped from a segment's text.
-fn is_subject_noun(word: &str) -> bool {
-    matches!(
-        word,
-        "man"
-            | "woman"
-            | "girl"
-            | "boy"
-            | "child"
-            | "kid"
-            | "person"
-            | "someone"
-            | "athlete"
-            | "dancer"
-            | "player"
-            | "student"
-            | "soldier"
-            | "monk"
-            | "runner"
-            | "referee"
-            | "gymnast"
-            | "hiker"
-            | "fan"
-            | "winner"
-            | "singer"
-            | "model"
-            | "climber"
-            | "bodybuilder"
-            | "cheerleader"
-            | "goalkeeper"
-            | "people"
-            | "guy"
-            | "lady"
-            | "his"
-            | "her"
-            | "old"
-            | "young"
-    )
 }
 
 fn describe_names(postures: &[&NamedPosture]) -> String {

@@ -5,7 +5,7 @@ use crate::common::{llm_of, LlmArgs};
 use anyhow::Result;
 use clap::Args;
 use coma::agents::planner;
-use coma::agents::planner::timeline_set;
+use coma::agents::planner::{meaning, timeline_set};
 use coma::executor::block_on;
 use coma::plan::Plan;
 use coma::session::{self, PlanningContext, Progress, VOCABULARY_FILE};
@@ -121,9 +121,8 @@ pub fn run(args: PlanArgs) -> Result<()> {
                 args.models.display()
             );
         }
-        let similarity = timeline_set::embedding_similarity(&embed_fn);
-        let matcher =
-            timeline_set::Matcher::new(&similarity, timeline_set::SAME_MOVEMENT_MIN_SIMILARITY);
+        let similarity = meaning::embedding_similarity(&embed_fn);
+        let matcher = meaning::Matcher::new(&similarity, meaning::SAME_MOVEMENT_MIN_SIMILARITY);
         let mut failed = None;
         let mut planning = Duration::ZERO;
         let mut report = timeline_set::score(

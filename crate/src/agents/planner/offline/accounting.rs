@@ -97,7 +97,9 @@ pub(super) fn limb_phrases_without_movement(
         if i < covered_to {
             continue;
         }
-        let start = (0..i)
+        // The phrase starts after the movement named before it ("marches in place swinging
+        // both arms") or at a boundary or an opener, whichever comes last.
+        let opened = (0..i)
             .rev()
             .find(|&k| BOUNDARIES.contains(&words[k]) || OPENERS.contains(&words[k]))
             .map_or(0, |k| {
@@ -107,6 +109,8 @@ pub(super) fn limb_phrases_without_movement(
                     k
                 }
             });
+        let after_movement = found.iter().filter(|k| **k < i).max().map_or(0, |k| k + 1);
+        let start = opened.max(after_movement);
         let end = (i + 1..words.len())
             .find(|&k| BOUNDARIES.contains(&words[k]) || OPENERS.contains(&words[k]))
             .unwrap_or(words.len());
@@ -143,6 +147,11 @@ mod tests {
         // A movement found inside the phrase places it.
         let w = words("a person walks with both arms raised");
         assert!(limb_phrases_without_movement(&w, &[2, 6]).is_empty());
+        let w = words("she marches in place swinging both arms high");
+        assert_eq!(
+            limb_phrases_without_movement(&w, &[1]),
+            [("in place swinging both arms high".to_string(), "arm")]
+        );
         let w = words("the child hops , arms flapping like wings");
         assert_eq!(
             limb_phrases_without_movement(&w, &[2]),

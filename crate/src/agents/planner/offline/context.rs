@@ -133,7 +133,7 @@ fn purpose_at(words: &[&str], i: usize) -> bool {
                 && !next.ends_with("ing")
                 && !next.ends_with("ed")
                 // A plural noun ("signals to cars"): a verb's bare form seldom ends in one s.
-                && !(next.ends_with('s') && !next.ends_with("ss"))
+                && (!next.ends_with('s') || next.ends_with("ss"))
                 && !matches!(*next, "music" | "rhythm" | "himself" | "herself")
         })
 }
@@ -156,6 +156,13 @@ pub(super) fn whole_clause(words: &[&str], names_movement: bool) -> Option<Conte
         return Some(Context::Setting);
     }
     None
+}
+
+/// Whether the words that open a sentence, up to its first comma, are context ("in the
+/// rain", "to warm up", "hearing a loud noise"): a setting, a purpose, a reason or a state,
+/// at most six words.
+pub(super) fn opens_context(words: &[&str]) -> bool {
+    words.len() <= 6 && whole_clause(words, false).is_some()
 }
 
 /// Where a purpose or a reason starts inside a clause that moves ("bows to greet the

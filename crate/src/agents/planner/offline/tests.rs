@@ -721,3 +721,120 @@ fn a_dataset_action_needs_its_label_and_its_caption_words() {
     assert!(!Repertoire::new(None).knows_any());
     assert!(!Repertoire::new(Some(&v1_vocabulary())).knows_any());
 }
+
+#[test]
+fn a_clause_moving_on_to_a_second_movement_keeps_both_and_what_rides_on_them() {
+    let p = plan(
+        "A woman picks up speed from a walk to a run, holding the T-pose.",
+        None,
+    );
+    assert_eq!(
+        bases(&p),
+        ["a person walks forward", "a person runs forward"],
+        "{p:#?}"
+    );
+    for s in &p.segments {
+        let track = s.postures.as_ref().unwrap_or_else(|| panic!("{s:#?}"));
+        assert!(!track.whole_body(), "{track:?}");
+        assert_eq!(track.keys[0].script.name.as_deref(), Some("T-pose"));
+    }
+    // Two whole-body movements at once: one is made, the other named in a note.
+    let both = plan("a person dances while walking", None);
+    assert_eq!(both.segments.len(), 1);
+    assert!(
+        both.notes
+            .iter()
+            .any(|n| n.contains("\"walking\"") && n.contains(NOT_PLACED)),
+        "{:?}",
+        both.notes
+    );
+}
+
+#[test]
+fn settings_reasons_and_states_are_dropped_with_a_note() {
+    for (prompt, context, bases_wanted) in [
+        (
+            "At the birthday party, a child jumps up and down.",
+            "at the birthday party",
+            1,
+        ),
+        (
+            "A man bows to greet the guests, then walks backward.",
+            "to greet the guests",
+            2,
+        ),
+        // Cut at "after": both halves are dropped.
+        (
+            "Feeling tired after the marathon, a man walks forward.",
+            "feeling tired",
+            1,
+        ),
+        (
+            "Feeling tired after the marathon, a man walks forward.",
+            "the marathon",
+            1,
+        ),
+    ] {
+        let p = plan(prompt, None);
+        assert!(
+            p.notes
+                .iter()
+                .any(|n| n.contains(&format!("\"{context}\"")) && n.ends_with("; dropped")),
+            "{prompt}: {:?}",
+            p.notes
+        );
+        assert_eq!(p.segments.len(), bases_wanted, "{prompt}: {p:#?}");
+        assert!(
+            p.segments
+                .iter()
+                .all(|s| !s.text.contains("greet") && !s.text.contains("party")),
+            "{prompt}: {p:#?}"
+        );
+    }
+}
+
+#[test]
+fn every_movement_a_clause_names_is_placed_or_named_in_a_note() {
+    // No rule (and no sentence encoder here) for these arms: named, with the reason.
+    let p = plan(
+        "He spins while having his right arm upwards and the left arm extended forward.",
+        None,
+    );
+    for phrase in [
+        "having his right arm upwards",
+        "the left arm extended forward",
+    ] {
+        assert!(
+            p.notes
+                .iter()
+                .any(|n| n.contains(&format!("\"{phrase}\"")) && n.contains(NOT_PLACED)),
+            "{phrase}: {:?}",
+            p.notes
+        );
+    }
+    // A knee lifted is no hand raised.
+    let knee = plan("A person lifts the right knee up high.", None);
+    assert!(
+        knee.segments.iter().all(|s| !s.text.contains("hand")),
+        "{knee:#?}"
+    );
+    // Standing up after a squat is the squat's; the walk after it is not.
+    let v2 = v2_vocabulary();
+    let after = plan_for(
+        "A man squats, then stands up and walks to the left.",
+        Some(&v2),
+        None,
+    );
+    assert_eq!(
+        bases(&after),
+        ["a person does a squat", "a person walks to the left"],
+        "{after:#?}"
+    );
+    // Holding the pose holds what there is.
+    let held = plan("A dancer bows and holds the pose.", None);
+    assert!(
+        held.notes.iter().all(|n| !n.contains(SUBSTITUTED)),
+        "{:?}",
+        held.notes
+    );
+}

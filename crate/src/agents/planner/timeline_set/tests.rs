@@ -1,4 +1,5 @@
 use super::*;
+use crate::agents::planner::meaning::{calibrate, opposite_directions, LabelledPair};
 use crate::plan::{PartEdits, PlannerKind, Segment};
 use crate::posture::library::Library;
 use crate::posture::track::PostureTrack;
