@@ -310,6 +310,36 @@ struct ScriptFields {
 }
 
 impl PostureScript {
+    /// The same pose on the other side of the body: every left and right swapped (joints,
+    /// limbs, contacts, "to the left of", a lean or a twist to the left), so "pointing
+    /// forward" with the right arm becomes the left arm's.
+    ///
+    /// Done on the script's own JSON form, where each of these is a `left`/`right` name
+    /// (`left_elbow`, `right_of`, `left`): one swap covers every kind of constraint, present
+    /// and future, where a table per kind would have to be kept in step with the enums.
+    pub fn mirrored(&self) -> PostureScript {
+        fn swap(value: &mut serde_json::Value) {
+            match value {
+                serde_json::Value::String(s) => {
+                    if let Some(rest) = s.strip_prefix("left") {
+                        *s = format!("right{rest}");
+                    } else if let Some(rest) = s.strip_prefix("right") {
+                        *s = format!("left{rest}");
+                    }
+                }
+                serde_json::Value::Array(items) => items.iter_mut().for_each(swap),
+                serde_json::Value::Object(fields) => fields
+                    .iter_mut()
+                    .filter(|(k, _)| k.as_str() != "name")
+                    .for_each(|(_, v)| swap(v)),
+                _ => {}
+            }
+        }
+        let mut value = serde_json::to_value(self).expect("a script is plain data");
+        swap(&mut value);
+        serde_json::from_value(value).expect("the mirror of a script is a script")
+    }
+
     /// Reads a script from JSON text and checks it (see [`PostureScript::check`]).
     pub fn parse(text: &str) -> Result<PostureScript, ScriptError> {
         let value: serde_json::Value =

@@ -402,7 +402,7 @@ fn place_limb_phrases(
             continue;
         };
         for segment in made.iter_mut() {
-            match movement {
+            match &movement {
                 limbs::LimbMovement::Gesture(g) => {
                     for part in g.arms() {
                         segment.parts.set(*part, Some(g.caption()));

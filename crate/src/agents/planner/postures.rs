@@ -530,13 +530,17 @@ pub fn plan_clause(
     }
     let named = named_words(words, &mentions);
     let mut notes = Vec::new();
-    let postures: Vec<&NamedPosture> = mentions
+    // A one-arm posture goes on the arm the clause names ("points … with his left arm" is
+    // the library's right-arm pointing, mirrored).
+    let arm = arm_side(words);
+    let postures: Vec<NamedPosture> = mentions
         .iter()
         .filter_map(|(_, n)| match n {
-            Named::Posture(p) => Some(*p),
+            Named::Posture(p) => Some(on_arm(p, arm)),
             Named::Action(_) => None,
         })
         .collect();
+    let postures: Vec<&NamedPosture> = postures.iter().collect();
     let action = mentions.iter().find_map(|(r, n)| match n {
         Named::Action(a) => Some((r.clone(), *a)),
         Named::Posture(_) => None,
@@ -669,6 +673,49 @@ pub fn plan_clause(
         over_model: false,
         named,
     })
+}
+
+/// The arm a clause names: the side word just before "arm", "hand", "fist" or "finger" ("with
+/// his left arm", "the right index finger"); `None` when it names none, or both.
+fn arm_side(words: &[&str]) -> Option<BodyPart> {
+    let mut found = None;
+    for (i, w) in words.iter().enumerate() {
+        let part = match *w {
+            "left" => BodyPart::LeftArm,
+            "right" => BodyPart::RightArm,
+            _ => continue,
+        };
+        let names_arm = words[i + 1..]
+            .iter()
+            .take(2)
+            .any(|n| matches!(*n, "arm" | "hand" | "fist" | "finger" | "index"));
+        if names_arm {
+            if found.is_some_and(|f| f != part) {
+                return None;
+            }
+            found = Some(part);
+        }
+    }
+    found
+}
+
+/// `posture` on `arm`: its mirror, named for that arm, when it is a posture of the other arm
+/// alone; itself otherwise.
+pub fn on_arm(posture: &NamedPosture, arm: Option<BodyPart>) -> NamedPosture {
+    match (arm, posture.parts.as_slice()) {
+        (Some(arm), [own]) if own.mirrored() == arm => {
+            let name = format!("{} with the {}", posture.name, arm.name());
+            let mut script = posture.script.mirrored();
+            script.name = Some(name.clone());
+            NamedPosture {
+                name,
+                synonyms: Vec::new(),
+                parts: vec![arm],
+                script,
+            }
+        }
+        _ => posture.clone(),
+    }
 }
 
 /// The indices of `words` inside a library mention (byte ranges of the words joined by

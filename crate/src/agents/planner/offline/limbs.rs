@@ -6,16 +6,18 @@
 
 use super::super::lexicon::{Action, Side};
 use super::super::meaning::Matcher;
+use super::super::postures::on_arm;
 use crate::posture::library::{Library, NamedPosture};
 use crate::skeleton::BodyPart;
 
 /// What a limb phrase is placed as.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(super) enum LimbMovement {
     /// A gesture of the lexicon, as a part edit of the model's motion.
     Gesture(Action),
-    /// A posture of the library held on its arms.
-    Posture(&'static NamedPosture),
+    /// A posture of the library held on its arms (mirrored onto the other arm where the
+    /// library has it on one arm only).
+    Posture(NamedPosture),
 }
 
 impl LimbMovement {
@@ -89,10 +91,15 @@ pub(super) fn nearest_arm_movement(
                 .same(&said, &g.caption())
                 .map(|s| (LimbMovement::Gesture(g), s))
         });
+    let one_arm = match side {
+        Side::Left => Some(BodyPart::LeftArm),
+        Side::Right => Some(BodyPart::RightArm),
+        Side::Both => None,
+    };
     let postures = Library::builtin()
         .all()
         .filter_map(|n| match n {
-            crate::posture::library::Named::Posture(p) => Some(p),
+            crate::posture::library::Named::Posture(p) => Some(on_arm(p, one_arm)),
             _ => None,
         })
         .filter(|p| {
@@ -101,8 +108,15 @@ pub(super) fn nearest_arm_movement(
             parts == arms
         })
         .filter_map(|p| {
+            // Matched by the library's own name: the mirrored one names its arm too.
+            let name = p
+                .name
+                .split(" with the ")
+                .next()
+                .unwrap_or(&p.name)
+                .to_string();
             matcher
-                .same(&said, &p.name)
+                .same(&said, &name)
                 .map(|s| (LimbMovement::Posture(p), s))
         });
     gestures.chain(postures).max_by(|a, b| a.1.total_cmp(&b.1))
@@ -135,5 +149,9 @@ mod tests {
         // Both arms: a posture of both arms only.
         let (found, _) = nearest_arm_movement(&["arms", "crossed"], &matcher).unwrap();
         assert_eq!(found.describe(), "arms crossed");
+        // The library points with the right arm only; the left arm points with its mirror.
+        let (found, _) = nearest_arm_movement(&["left", "pointing", "forward"], &matcher).unwrap();
+        assert_eq!(found.parts(), [BodyPart::LeftArm]);
+        assert_eq!(found.describe(), "pointing forward with the left arm");
     }
 }
