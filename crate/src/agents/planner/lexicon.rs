@@ -877,6 +877,17 @@ pub fn is_finite_verb(word: &str) -> bool {
         )
 }
 
+/// A clause without the words that name the person at its start ("a dancer spreads …" is
+/// "spreads …"): segment texts are about "a person", and "dancer" would make any clause a
+/// dance to the sentence encoder.
+pub fn without_subject<'a>(words: &[&'a str]) -> Vec<&'a str> {
+    words
+        .iter()
+        .copied()
+        .skip_while(|w| is_subject_word(w) || is_subject_noun(w))
+        .collect()
+}
+
 /// Nouns prompts use for the person ("the girl", "an athlete"): dropped from a segment's text.
 pub fn is_subject_noun(word: &str) -> bool {
     matches!(

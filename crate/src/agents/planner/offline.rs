@@ -1075,15 +1075,13 @@ fn nearest_action(
     {
         return None;
     }
-    let clause = format!("a person {}", without_subject(words).join(" "));
+    let clause = format!("a person {}", lexicon::without_subject(words).join(" "));
     // A substitute must mean the same movement, as the calibrated judgement of
     // [`meaning`] has it (sides aside, never the opposite direction or gait), and keep the
     // side the clause names.
-    let side = words.iter().find_map(|w| match *w {
-        "left" => Some(Side::Left),
-        "right" => Some(Side::Right),
-        _ => None,
-    });
+    let side = words
+        .iter()
+        .find_map(|w| side_word(w).filter(|s| *s != Side::Both));
     // The sided front kicks, where the model knows them, stand for the Bandai kick (as
     // `dataset_action` reads "kicks").
     let sided_kicks = known.knows(Action::FrontKick(Side::Right));
@@ -1112,22 +1110,12 @@ fn nearest_library_entry(words: &[&str], matcher: Option<&Matcher>) -> Option<(S
     {
         return None;
     }
-    let clause = format!("a person {}", without_subject(words).join(" "));
+    let clause = format!("a person {}", lexicon::without_subject(words).join(" "));
     Library::builtin()
         .all()
         .filter_map(|n| matcher.same(&clause, n.name()).map(|s| (n.name(), s)))
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(name, s)| (name.to_string(), s))
-}
-
-/// A clause without the words that name the person ("a dancer spreads …" is "spreads …"):
-/// "dancer" would make any clause a dance.
-fn without_subject<'a>(words: &[&'a str]) -> Vec<&'a str> {
-    words
-        .iter()
-        .copied()
-        .skip_while(|w| lexicon::is_subject_word(w) || lexicon::is_subject_noun(w))
-        .collect()
 }
 
 /// Whether a caption names the side opposite to `side` and not `side` itself.

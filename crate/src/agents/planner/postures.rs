@@ -362,11 +362,7 @@ pub fn hold_segment(words: &[&str], previous: &Segment) -> Option<Segment> {
     script.hold = HOLD_EXTRA_SECONDS;
     let mut held = PostureTrack::holding(track.parts.clone(), script);
     held.keys[0].transition = 0.3;
-    let subject_free: Vec<&str> = words
-        .iter()
-        .skip_while(|w| lexicon::is_subject_word(w) || lexicon::is_subject_noun(w))
-        .copied()
-        .collect();
+    let subject_free = lexicon::without_subject(words);
     Some(Segment {
         text: format!("a person {}", subject_free.join(" ")),
         seconds: clamp_seconds(held.natural_seconds()).unwrap_or(2.0),
@@ -654,11 +650,7 @@ pub fn plan_clause(
     // The key poses, and the way out into whatever comes next.
     let seconds =
         clamp_seconds(track.natural_seconds() + DEFAULT_TRANSITION_SECONDS).unwrap_or(2.0);
-    let subject_free: Vec<&str> = words
-        .iter()
-        .skip_while(|w| lexicon::is_subject_word(w) || lexicon::is_subject_noun(w))
-        .copied()
-        .collect();
+    let subject_free = lexicon::without_subject(words);
     let segment = Segment {
         text: format!("a person {}", subject_free.join(" ")),
         seconds,
