@@ -13,7 +13,7 @@ use crate::model::edit::PartText;
 use crate::model::generate::MotionTokens;
 use crate::model::motion_model::sampling;
 use crate::model::MotionModel;
-use crate::plan::{Plan, Segment};
+use crate::plan::{Clip, Plan, Segment};
 use crate::share::{Edit, EditKind};
 use crate::skeleton::{BodyPart, Pose};
 use crate::timing::frames_for_seconds;
@@ -66,6 +66,8 @@ pub enum RunEvent<'a> {
     },
     /// The segments are joined.
     Blended,
+    /// Clip `index` of the body-part tracks was generated over its span.
+    ClipLaid { index: usize, clip: &'a Clip },
 }
 
 /// One review round as it was decided.
@@ -310,6 +312,7 @@ pub async fn run<T: Transport>(
     if plan.segments.len() > 1 {
         progress(RunEvent::Blended);
     }
+    let tokens = lay_clips(model, &plan, tokens, options.seed, &mut history, progress).await;
     Run {
         plan,
         segments,
@@ -356,6 +359,132 @@ async fn blend(
     joined
 }
 
+/// The plan's clips that generate motion (not key poses) laid on the blended motion in start
+/// order, each on its parts over its span (see [`MotionModel::edit_parts_span`]), the rest of
+/// the body conditioned on the base motion of the segment under the clip's middle. Clip
+/// `index` samples with its own seed, so a link's history names it.
+pub async fn lay_clips(
+    model: &MotionModel,
+    plan: &Plan,
+    mut tokens: MotionTokens,
+    run_seed: u64,
+    history: &mut Vec<Edit>,
+    progress: &mut dyn FnMut(RunEvent),
+) -> MotionTokens {
+    for (index, clip) in plan.clips.iter().enumerate() {
+        if clip.postures.is_some() {
+            continue;
+        }
+        let frames = clip_frames(plan, clip, &tokens);
+        let seed = seed_of(run_seed, CLIP_SEED_BASE + index, 0);
+        let rest = &plan.segments[plan.segment_at(clip.middle())].base;
+        tokens = model
+            .edit_parts_span(&tokens, &clip.text, &clip.parts, rest, frames.clone(), seed)
+            .await;
+        history.push(Edit {
+            kind: EditKind::BodyParts,
+            text: clip.text.clone(),
+            from_frame: frames.start as u32,
+            to_frame: frames.end as u32,
+            parts: part_bits(&clip.parts),
+            seed,
+        });
+        progress(RunEvent::ClipLaid { index, clip });
+    }
+    tokens
+}
+
+/// The motion of `tokens`, made under `before`, changed to follow `after`'s clips: a clip
+/// `after` no longer has (deleted, or moved) gives its parts back to the segment under it over
+/// its old span; a clip `after` has anew (added, moved, reworded) is generated over its span.
+/// The tokens outside those spans (and [`crate::model::edit::SEAM_STEPS`] steps around them)
+/// stay as they were. Only the clips may differ: a changed whole-body track is a new run.
+/// Returns the tokens and the edits, as a link's history records them.
+pub async fn edit_clips(
+    model: &MotionModel,
+    before: &Plan,
+    after: &Plan,
+    mut tokens: MotionTokens,
+    seed: u64,
+) -> Result<(MotionTokens, Vec<Edit>), String> {
+    if before.segments != after.segments {
+        return Err(
+            "only the body-part clips may change here; a changed whole-body track is a new run"
+                .into(),
+        );
+    }
+    let generated = |c: &&Clip| c.postures.is_none();
+    let mut edits = Vec::new();
+    let gone = before
+        .clips
+        .iter()
+        .filter(generated)
+        .filter(|c| !after.clips.contains(c));
+    for (k, clip) in gone.enumerate() {
+        let frames = clip_frames(before, clip, &tokens);
+        let segment = &before.segments[before.segment_at(clip.middle())];
+        let seed = seed_of(seed, CLIP_SEED_BASE + k, 1);
+        tokens = model
+            .regenerate_parts_span(
+                &tokens,
+                &clip.parts,
+                &segment.base,
+                &segment.parts.edits(),
+                frames.clone(),
+                seed,
+            )
+            .await;
+        edits.push(Edit {
+            kind: EditKind::BodyParts,
+            text: segment.base.clone(),
+            from_frame: frames.start as u32,
+            to_frame: frames.end as u32,
+            parts: part_bits(&clip.parts),
+            seed,
+        });
+    }
+    let new = after
+        .clips
+        .iter()
+        .filter(generated)
+        .filter(|c| !before.clips.contains(c));
+    for (k, clip) in new.enumerate() {
+        let frames = clip_frames(after, clip, &tokens);
+        let rest = &after.segments[after.segment_at(clip.middle())].base;
+        let seed = seed_of(seed, CLIP_SEED_BASE + k, 0);
+        tokens = model
+            .edit_parts_span(&tokens, &clip.text, &clip.parts, rest, frames.clone(), seed)
+            .await;
+        edits.push(Edit {
+            kind: EditKind::BodyParts,
+            text: clip.text.clone(),
+            from_frame: frames.start as u32,
+            to_frame: frames.end as u32,
+            parts: part_bits(&clip.parts),
+            seed,
+        });
+    }
+    Ok((tokens, edits))
+}
+
+/// Where clips' seeds start in [`seed_of`]'s segment index, past any segment's.
+const CLIP_SEED_BASE: usize = 5000;
+
+/// Feature rows (20 fps) a clip covers in the blended motion: each end at the same place
+/// within its segment as in the plan (segments are generated in whole token steps, so their
+/// frames drift from their seconds; a clip keeps to its segments).
+pub fn clip_frames(plan: &Plan, clip: &Clip, tokens: &MotionTokens) -> std::ops::Range<usize> {
+    let ranges = segment_ranges(plan, tokens);
+    let starts = plan.segment_starts();
+    let at = |t: f64| {
+        let k = plan.segment_at(t);
+        let within = ((t - starts[k]) * crate::timing::FPS).round().max(0.0) as usize;
+        (ranges[k].start + within).min(ranges[k].end)
+    };
+    let (from, to) = (at(clip.start), at(clip.end));
+    from..to.max(from)
+}
+
 /// Feature rows whose root travel is a path laid on purpose (segments with a trajectory):
 /// what [`crate::feet::plant_feet`] must not carry back to the feet.
 pub fn path_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range<usize>> {
@@ -386,7 +515,7 @@ pub fn segment_ranges(plan: &Plan, tokens: &MotionTokens) -> Vec<std::ops::Range
 
 /// The plan's posture tracks laid over a motion's features (not normalised, 20 fps, after its
 /// paths): posture segments replace the generated frames with their key poses, held postures
-/// take over their body parts (see [`crate::posture::track::lay_tracks`]). The features are
+/// (a segment's, or a clip's over its span) take over their body parts (see [`crate::posture::track::lay_tracks`]). The features are
 /// computed again from the new joints, on the reference skeleton. The notes say which key
 /// poses could not be met in full.
 pub fn lay_postures(
@@ -395,7 +524,7 @@ pub fn lay_postures(
     features: &[FeatureFrame],
 ) -> (Features, Vec<String>) {
     use crate::posture::track::{lay_tracks, TrackSpan};
-    let spans: Vec<TrackSpan> = plan
+    let mut spans: Vec<TrackSpan> = plan
         .segments
         .iter()
         .zip(segment_ranges(plan, tokens))
@@ -406,6 +535,12 @@ pub fn lay_postures(
             })
         })
         .collect();
+    spans.extend(plan.clips.iter().filter_map(|clip| {
+        clip.postures.as_ref().map(|track| TrackSpan {
+            frames: clip_frames(plan, clip, tokens),
+            track,
+        })
+    }));
     if spans.is_empty() || features.is_empty() {
         return (features.to_vec(), Vec::new());
     }
@@ -556,6 +691,17 @@ pub fn describe_event(event: &RunEvent) -> String {
             format!("segment {}, review {}: {what}", index + 1, round + 1)
         }
         RunEvent::Blended => "segments blended".to_string(),
+        RunEvent::ClipLaid { index, clip } => {
+            let names: Vec<&str> = clip.parts.iter().map(|p| p.name()).collect();
+            format!(
+                "clip {} ({:.1}–{:.1} s): {} ← \"{}\"",
+                index + 1,
+                clip.start,
+                clip.end,
+                names.join(" and "),
+                clip.text
+            )
+        }
     }
 }
 
@@ -656,6 +802,7 @@ mod tests {
                 segment(4.0, PartEdits::default()),
                 segment(2.1, PartEdits::default()),
             ],
+            clips: Vec::new(),
             planner: PlannerKind::Offline,
             notes: Vec::new(),
         };

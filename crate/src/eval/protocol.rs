@@ -197,6 +197,7 @@ fn reviewed(
         prompt: caption.to_string(),
         rewritten: caption.to_string(),
         segments: vec![segment],
+        clips: Vec::new(),
         planner: PlannerKind::Offline,
         notes: Vec::new(),
     };

@@ -34,6 +34,11 @@ pub fn part_text(global: &[f32; TEXT_DIM], overrides: &[(BodyPart, [f32; TEXT_DI
     })
 }
 
+/// Steps either side of a seam that [`Spam::edit_parts_span`] regenerates (0.4 s at 20 fps).
+pub const SEAM_STEPS: usize = 2;
+/// Steps of context either side of the masked steps when only a window of a motion is filled.
+const WINDOW_CONTEXT_STEPS: usize = 6;
+
 /// Time steps (of 4 frames) needed for `frames` frames, within the model's range.
 pub fn steps_for_frames(frames: usize, max_steps: usize) -> usize {
     (frames.div_ceil(FRAMES_PER_TOKEN)).clamp(1, max_steps)
@@ -199,6 +204,154 @@ impl Spam {
         });
         let donor = self.generate_steps(&donor_text, n, options).await;
         tokens.with_parts_from(&donor, &chosen)
+    }
+
+    /// Gives the chosen parts new tokens from their text over time steps `steps` only; the
+    /// other parts, and the chosen ones outside the span, keep theirs (a clip on a body-part
+    /// track). As in [`Spam::edit_parts`], the new tokens come from a donor motion made with
+    /// the whole body following the chosen parts' text; a span longer than one generation is
+    /// made in pieces. The [`SEAM_STEPS`] steps either side of each seam (the span's ends,
+    /// the joins of pieces) are then regenerated on the chosen parts with their neighbours
+    /// kept, so the parts move into and out of the clip rather than jump.
+    pub async fn edit_parts_span(
+        &self,
+        tokens: &MotionTokens,
+        text: &PartText,
+        parts: &[BodyPart],
+        steps: std::ops::Range<usize>,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let n = tokens[0][0].len();
+        let (a, b) = (steps.start.min(n), steps.end.min(n));
+        let chosen: Vec<usize> = (0..PARTS)
+            .filter(|p| parts.contains(&BodyPart::ALL[*p]))
+            .collect();
+        let Some(&first) = chosen.first() else {
+            return tokens.clone();
+        };
+        if a >= b {
+            return tokens.clone();
+        }
+        let donor_text: PartText = std::array::from_fn(|p| {
+            if chosen.contains(&p) {
+                text[p]
+            } else {
+                text[first]
+            }
+        });
+        let most = self.base_config.max_steps - 1;
+        let mut grid = tokens.clone().into_grid();
+        let mut seams = vec![a, b];
+        let mut start = a;
+        for piece in 0u64.. {
+            if start >= b {
+                break;
+            }
+            let len = (b - start).min(most);
+            let piece_options = SamplingOptions {
+                seed: options.seed.wrapping_add(piece),
+                ..options.clone()
+            };
+            let donor = self.generate_steps(&donor_text, len, &piece_options).await;
+            for &p in &chosen {
+                for (row, from) in grid[p].iter_mut().zip(&donor[p]) {
+                    row[start..start + len].copy_from_slice(&from[..len]);
+                }
+            }
+            start += len;
+            if start < b {
+                seams.push(start);
+            }
+        }
+        let mut joined = MotionTokens::from_model(grid);
+        for (k, &seam) in seams.iter().enumerate() {
+            if seam == 0 || seam == n {
+                continue;
+            }
+            let seam_options = SamplingOptions {
+                seed: options.seed.wrapping_add(1000 + k as u64),
+                ..options.clone()
+            };
+            let masked = seam.saturating_sub(SEAM_STEPS)..(seam + SEAM_STEPS).min(n);
+            joined = self
+                .fill_window(text, &joined, &chosen, masked, &seam_options)
+                .await;
+        }
+        joined
+    }
+
+    /// Regenerates the chosen parts over time steps `steps` from `text`, with the other parts
+    /// and the steps around kept (a clip taken off a body-part track: the parts go back to
+    /// what the text of the rest says). A span longer than a window is filled a piece at a
+    /// time, each piece reading the one before as context.
+    pub async fn regenerate_parts_span(
+        &self,
+        tokens: &MotionTokens,
+        text: &PartText,
+        parts: &[BodyPart],
+        steps: std::ops::Range<usize>,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let n = tokens[0][0].len();
+        let chosen: Vec<usize> = (0..PARTS)
+            .filter(|p| parts.contains(&BodyPart::ALL[*p]))
+            .collect();
+        let most = self.base_config.max_steps - 1 - 2 * WINDOW_CONTEXT_STEPS;
+        let mut out = tokens.clone();
+        let mut start = steps.start.min(n);
+        let end = steps.end.min(n);
+        let mut piece = 0u64;
+        while start < end && !chosen.is_empty() {
+            let to = (start + most).min(end);
+            let piece_options = SamplingOptions {
+                seed: options.seed.wrapping_add(piece),
+                ..options.clone()
+            };
+            out = self
+                .fill_window(text, &out, &chosen, start..to, &piece_options)
+                .await;
+            start = to;
+            piece += 1;
+        }
+        out
+    }
+
+    /// Regenerates steps `masked` of the parts `chosen` (model indices) with the rest kept,
+    /// reading [`WINDOW_CONTEXT_STEPS`] steps of context either side: the window, not the
+    /// whole motion, goes through the transformers, so it works on motions longer than one
+    /// generation.
+    async fn fill_window(
+        &self,
+        text: &PartText,
+        tokens: &MotionTokens,
+        chosen: &[usize],
+        masked: std::ops::Range<usize>,
+        options: &SamplingOptions,
+    ) -> MotionTokens {
+        let n = tokens[0][0].len();
+        let from = masked.start.saturating_sub(WINDOW_CONTEXT_STEPS);
+        let to = (masked.end + WINDOW_CONTEXT_STEPS).min(n);
+        let window = MotionTokens::from_model(
+            tokens
+                .iter()
+                .map(|part| part.iter().map(|row| row[from..to].to_vec()).collect())
+                .collect(),
+        );
+        let editable: Vec<Vec<bool>> = (0..PARTS)
+            .map(|p| {
+                (from..to)
+                    .map(|s| chosen.contains(&p) && masked.contains(&s))
+                    .collect()
+            })
+            .collect();
+        let filled = self.fill(text, Some(&window), &editable, options).await;
+        let mut grid = tokens.clone().into_grid();
+        for (part, new) in grid.iter_mut().zip(filled.iter()) {
+            for (row, new) in part.iter_mut().zip(new) {
+                row[from..to].copy_from_slice(new);
+            }
+        }
+        MotionTokens::from_model(grid)
     }
 
     /// Joins `a` then `b`: the last `overlap` steps of `a` and the first `overlap` of `b` are

@@ -199,6 +199,59 @@ impl MotionModel {
             .await
     }
 
+    /// The `parts` regenerated from `instruction` over frames `frames` (20 fps) only: a clip
+    /// on a body-part track. The other parts, conditioned on `rest`, and the chosen parts
+    /// outside the span keep their tokens, but for [`crate::model::edit::SEAM_STEPS`] steps
+    /// either side of the span's ends, where the parts move into and out of the clip.
+    pub async fn edit_parts_span(
+        &self,
+        tokens: &MotionTokens,
+        instruction: &str,
+        parts: &[BodyPart],
+        rest: &str,
+        frames: std::ops::Range<usize>,
+        seed: u64,
+    ) -> MotionTokens {
+        let edits: Vec<_> = parts
+            .iter()
+            .map(|p| (*p, instruction.to_string()))
+            .collect();
+        let steps = frames.start / FRAMES_PER_TOKEN..frames.end.div_ceil(FRAMES_PER_TOKEN);
+        self.spam
+            .edit_parts_span(
+                tokens,
+                &self.condition(rest, &edits),
+                parts,
+                steps,
+                &sampling(seed),
+            )
+            .await
+    }
+
+    /// The `parts` regenerated over frames `frames` (20 fps) from the condition of what the
+    /// rest of the body does (`rest`, and the parts' own instructions in `own`), the other
+    /// parts and the frames around kept: a clip taken off.
+    pub async fn regenerate_parts_span(
+        &self,
+        tokens: &MotionTokens,
+        parts: &[BodyPart],
+        rest: &str,
+        own: &[(BodyPart, String)],
+        frames: std::ops::Range<usize>,
+        seed: u64,
+    ) -> MotionTokens {
+        let steps = frames.start / FRAMES_PER_TOKEN..frames.end.div_ceil(FRAMES_PER_TOKEN);
+        self.spam
+            .regenerate_parts_span(
+                tokens,
+                &self.condition(rest, own),
+                parts,
+                steps,
+                &sampling(seed),
+            )
+            .await
+    }
+
     /// The features (not normalised) of tokens.
     pub async fn features(&self, tokens: &MotionTokens) -> Features {
         self.normalizer.denormalize(&self.spam.decode(tokens).await)

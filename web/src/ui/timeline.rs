@@ -2,6 +2,7 @@
 //! poses; a time range and body parts to edit with an instruction (in-between or body-part
 //! edit) or to hold a named posture on (see [`super::postures`]); undo and redo.
 
+use super::clips::{add_clip, ClipTracks};
 use super::postures::PosturePicker;
 use super::segments::{next_seed, shown_segments, PlanList, SegmentBar};
 use crate::app::{AppState, Pending};
@@ -101,6 +102,28 @@ pub fn Timeline() -> impl IntoView {
             }),
         );
     };
+    let add = move |_| {
+        let text = instruction.get_untracked().trim().to_string();
+        if text.is_empty() {
+            return state.fail("Type what the parts should do first.");
+        }
+        let chosen: Vec<BodyPart> = BodyPart::ALL
+            .iter()
+            .zip(parts.get_untracked())
+            .filter(|(_, c)| *c)
+            .map(|(p, _)| *p)
+            .collect();
+        if chosen.is_empty() {
+            return state.fail("Tick the body parts the clip moves first.");
+        }
+        add_clip(
+            state,
+            chosen,
+            text,
+            from.get_untracked(),
+            to.get_untracked(),
+        );
+    };
     let step = move |undo: bool| {
         state.history.update(|h| {
             if undo {
@@ -116,6 +139,7 @@ pub fn Timeline() -> impl IntoView {
     view! {
         <div class="panel timeline">
             <SegmentBar shown/>
+            <ClipTracks from to/>
             <PlanList shown/>
             <div class="row">
                 <label>
@@ -183,6 +207,14 @@ pub fn Timeline() -> impl IntoView {
                 </button>
                 <button on:click=edit_parts disabled=move || state.busy() || !has_take()>
                     "Edit parts"
+                </button>
+                <button
+                    id="add-clip"
+                    title="A clip on the ticked parts' tracks over the range"
+                    on:click=add
+                    disabled=move || state.busy() || !has_take()
+                >
+                    "Add clip"
                 </button>
                 <button
                     id="undo"

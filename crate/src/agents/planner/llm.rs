@@ -11,8 +11,8 @@ use crate::agents::llm::{
 };
 use crate::dataset::Vocabulary;
 use crate::plan::{
-    clamp_seconds, clean_text, PartEdits, Plan, PlannerKind, Segment, MAX_PLAN_SECONDS,
-    MAX_SEGMENTS,
+    clamp_seconds, clean_text, Clip, PartEdits, Plan, PlannerKind, Segment, MAX_CLIPS,
+    MAX_PLAN_SECONDS, MAX_SEGMENTS,
 };
 use crate::posture::script::PostureScript;
 use crate::posture::track::{PostureTrack, TrackKey, DEFAULT_TRANSITION_SECONDS};
@@ -60,18 +60,25 @@ pub async fn plan<T: Transport>(
         };
     progress(&PlanEvent::Rewritten(rewritten.clone()));
 
-    let pieces = match ask::<SegmentReply, _>(client, segment_messages(&rewritten), "segment")
+    let Timeline {
+        segments: pieces,
+        clips,
+    } = match ask::<SegmentReply, _>(client, segment_messages(&rewritten), "segment")
         .await
         .and_then(|r| r.validate().map_err(StepError::Invalid))
     {
-        Ok(pieces) => pieces,
+        Ok(timeline) => timeline,
         Err(e) => {
             notes.push(e.note("segment"));
-            offline::plan_for(&source, Some(vocabulary), embed)
-                .segments
-                .into_iter()
-                .map(|s| (s.text, s.seconds))
-                .collect()
+            let built_in = offline::plan_for(&source, Some(vocabulary), embed);
+            Timeline {
+                segments: built_in
+                    .segments
+                    .into_iter()
+                    .map(|s| (s.text, s.seconds))
+                    .collect(),
+                clips: built_in.clips,
+            }
         }
     };
     progress(&PlanEvent::Segmented(pieces.clone()));
@@ -103,6 +110,7 @@ pub async fn plan<T: Transport>(
         prompt: prompt.to_string(),
         rewritten,
         segments,
+        clips,
         planner: PlannerKind::Llm {
             model: client.config().model.clone(),
         },
@@ -189,6 +197,18 @@ impl Schema for RewriteReply {
 #[serde(deny_unknown_fields)]
 struct SegmentReply {
     segments: Vec<SegmentPiece>,
+    /// What some body parts do over a span of their own, across or within segments.
+    #[serde(default)]
+    clips: Vec<ClipPiece>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ClipPiece {
+    parts: Vec<String>,
+    text: String,
+    start: f64,
+    end: f64,
 }
 
 #[derive(Deserialize)]
@@ -213,6 +233,23 @@ impl Schema for SegmentReply {
                     "required": ["text", "seconds"],
                     "additionalProperties": false
                 }
+            },
+            "clips": {
+                "type": "array", "maxItems": MAX_CLIPS,
+                "items": {
+                    "type": "object",
+                    "properties": {
+                        "parts": {
+                            "type": "array", "minItems": 1, "maxItems": 3,
+                            "items": {"enum": ["left_arm", "right_arm", "left_leg", "right_leg"]}
+                        },
+                        "text": {"type": "string", "maxLength": 300},
+                        "start": {"type": "number", "minimum": 0, "maximum": MAX_PLAN_SECONDS},
+                        "end": {"type": "number", "minimum": 0, "maximum": MAX_PLAN_SECONDS}
+                    },
+                    "required": ["parts", "text", "start", "end"],
+                    "additionalProperties": false
+                }
             }},
             "required": ["segments"],
             "additionalProperties": false
@@ -225,7 +262,9 @@ impl Schema for SegmentReply {
 }
 
 impl SegmentReply {
-    fn validate(&self) -> Result<Vec<(String, f64)>, String> {
+    /// The segments' texts and lengths, and the clips checked against them (see
+    /// [`Clip::checked`]; clips that overlap on a part are refused, for the LLM to mend).
+    fn validate(&self) -> Result<Timeline, String> {
         if self.segments.is_empty() || self.segments.len() > MAX_SEGMENTS {
             return Err(format!(
                 "it has {} segments; give 1 to {MAX_SEGMENTS}",
@@ -251,8 +290,54 @@ impl SegmentReply {
                 "its segments last {seconds:.1} s; give at most {MAX_PLAN_SECONDS} s in all"
             ));
         }
-        Ok(segments)
+        if self.clips.len() > MAX_CLIPS {
+            return Err(format!(
+                "it has {} clips; give at most {MAX_CLIPS}",
+                self.clips.len()
+            ));
+        }
+        let mut clips: Vec<Clip> = Vec::new();
+        for (i, c) in self.clips.iter().enumerate() {
+            let parts = c
+                .parts
+                .iter()
+                .map(|p| {
+                    BodyPart::parse(p).ok_or_else(|| {
+                        format!(
+                            "clip {}: \"{p}\" is not a body part (left_arm, right_arm, \
+                             left_leg, right_leg)",
+                            i + 1
+                        )
+                    })
+                })
+                .collect::<Result<Vec<_>, String>>()?;
+            let clip = Clip {
+                parts,
+                text: c.text.clone(),
+                start: c.start,
+                end: c.end,
+                postures: None,
+            }
+            .checked(seconds)
+            .map_err(|e| format!("clip {}: {e}", i + 1))?;
+            if let Some(other) = clips.iter().find(|o| o.overlaps(&clip)) {
+                return Err(format!(
+                    "clips \"{}\" and \"{}\" move the same body part at the same time",
+                    other.text, clip.text
+                ));
+            }
+            clips.push(clip);
+        }
+        Ok(Timeline { segments, clips })
     }
+}
+
+/// The segment step's answer: the whole-body track's texts and lengths, and the clips of the
+/// body-part tracks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Timeline {
+    pub segments: Vec<(String, f64)>,
+    pub clips: Vec<Clip>,
 }
 
 #[derive(Deserialize)]
@@ -565,8 +650,15 @@ fn segment_messages(description: &str) -> Vec<Message> {
              (walking while waving) stay in one segment, and a repeated whole-body action \
              (bowing twice) is one segment per repetition. Give each segment a duration in seconds between 2 and 9.8 (a few steps of walking take \
              about 4 s, a bow about 3 s, a wave about 3 s). Write each segment's text as a \
-             full sentence about \"a person\". Reply in JSON: {{\"segments\": [{{\"text\": \
-             \"...\", \"seconds\": 4}}]}}."
+             full sentence about \"a person\". Something some body parts do over a span \
+             of its own, across segments or within one (holding a T-pose through a walk and a \
+             run, waving the left hand for the last two seconds), is a clip: its parts (from \
+             left_arm, right_arm, left_leg, right_leg), a caption of what they do (\"a person \
+             waves the left hand\"), and its start and end in seconds from the start of the \
+             first segment; clips on the same part do not overlap. Reply in JSON: \
+             {{\"segments\": [{{\"text\": \"...\", \"seconds\": 4}}], \"clips\": \
+             [{{\"parts\": [\"left_arm\"], \"text\": \"...\", \"start\": 2, \"end\": 6}}]}}; \
+             \"clips\" may be empty."
         )),
         Message::user(description.to_string()),
     ]

@@ -43,6 +43,7 @@ mod accounting;
 mod anaphora;
 mod context;
 mod limbs;
+mod tracks;
 
 use context::Context;
 
@@ -111,6 +112,8 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 .is_some_and(|next| postures::keeps_pose_before(next)),
         })
         .collect();
+    // The clause each segment came from.
+    let mut clause_of: Vec<usize> = Vec::new();
     for (k, words) in clauses.iter().enumerate() {
         let words = words.as_slice();
         let reader = readers[k];
@@ -284,6 +287,7 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         if segments.len() == clause_start && notes.len() == notes_start && !words.is_empty() {
             notes.push(format!("\"{}\" {UNREAD}", words.join(" ")));
         }
+        clause_of.resize(segments.len(), k);
     }
     if segments.is_empty() {
         let fallback =
@@ -317,10 +321,12 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         ));
         segments.truncate(fit);
     }
+    let clips = tracks::clips_across_segments(&mut segments, &clause_of);
     Plan {
         prompt: prompt.to_string(),
         rewritten: rewrite(&segments),
         segments,
+        clips,
         planner: PlannerKind::Offline,
         notes,
     }

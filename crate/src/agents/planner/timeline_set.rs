@@ -460,10 +460,13 @@ fn text_count(text: &str) -> u32 {
 
 /// What a plan holds, element by element, with times from the segments' lengths: each
 /// segment's base motion (with its path), each body-part instruction (parts with the same
-/// instruction as one element: "both arms"), and each posture track (the library movement it
+/// instruction as one element: "both arms"), each clip of the body-part tracks, and each
+/// posture track (the library movement it
 /// plays, else the names of its key poses; a track that holds both legs carries the whole
 /// body and its path, and the base motion under it is replaced).
 pub fn plan_elements(plan: &Plan) -> Vec<Element> {
+    // Every part instruction as a clip, the segments' own included.
+    let plan = &plan.lifted();
     let mut out = Vec::new();
     let mut t = 0.0;
     for (k, s) in plan.segments.iter().enumerate() {
@@ -480,24 +483,6 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
                 end,
                 count: text_count(&s.base),
                 path: s.trajectory.as_ref().map(|t| t.describe()),
-                segment: k,
-            });
-        }
-        let mut groups: Vec<(Vec<BodyPart>, String)> = Vec::new();
-        for (part, text) in s.parts.edits() {
-            match groups.iter_mut().find(|(_, t)| *t == text) {
-                Some((parts, _)) => parts.push(part),
-                None => groups.push((vec![part], text)),
-            }
-        }
-        for (parts, text) in groups {
-            out.push(Element {
-                on: On::Parts(parts),
-                count: text_count(&text),
-                text,
-                start,
-                end,
-                path: None,
                 segment: k,
             });
         }
@@ -529,6 +514,25 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
                 segment: k,
             });
         }
+    }
+    for clip in &plan.clips {
+        let (text, count) = match &clip.postures {
+            Some(track) => {
+                let names = distinct_names(track.keys.iter().map(|k| &k.script));
+                let text = library_movement(&names).unwrap_or_else(|| names.join(", "));
+                (text, track.repeat.max(1))
+            }
+            None => (clip.text.clone(), text_count(&clip.text)),
+        };
+        out.push(Element {
+            on: On::Parts(clip.parts.clone()),
+            text,
+            start: clip.start,
+            end: clip.end,
+            count,
+            path: None,
+            segment: plan.segment_at(clip.start),
+        });
     }
     out
 }

@@ -296,3 +296,42 @@ fn a_small_budget_keeps_the_actions_and_drops_the_examples_first() {
         assert!(small.contains(action.as_str()), "{action} missing");
     }
 }
+
+#[test]
+fn the_llm_writes_clips_of_its_own_and_overlapping_ones_go_back_with_the_error() {
+    let walk_run = r#"{"segments": [{"text": "a person walks forward", "seconds": 4},
+        {"text": "a person runs forward", "seconds": 4}], "clips": [CLIPS]}"#;
+    let t_pose = r#"{"parts": ["left_arm", "right_arm"], "text": "a person holds the arms out to the sides", "start": 1, "end": 8}"#;
+    let wave =
+        r#"{"parts": ["left_arm"], "text": "a person waves the left hand", "start": 6, "end": 12}"#;
+    let decompose = |base: &str| {
+        ScriptedReply::completion(&format!(
+            r#"{{"base": "{base}", "left_arm": null, "right_arm": null, "left_leg": null, "right_leg": null, "trajectory": null}}"#
+        ))
+    };
+    let server = ScriptServer::start([
+        good("rewrite"),
+        ScriptedReply::completion(&walk_run.replace("CLIPS", &format!("{t_pose}, {wave}"))),
+        ScriptedReply::completion(&walk_run.replace("CLIPS", t_pose)),
+        decompose("a person walks forward"),
+        decompose("a person runs forward"),
+    ])
+    .unwrap();
+    let (plan, _) = run(&server);
+    assert!(plan.notes.is_empty(), "{:?}", plan.notes);
+    let retry = server.requests()[2].json().to_string();
+    assert!(
+        retry.contains("move the same body part at the same time"),
+        "{retry}"
+    );
+    assert_eq!(plan.clips.len(), 1);
+    let clip = &plan.clips[0];
+    assert_eq!(clip.parts, [BodyPart::LeftArm, BodyPart::RightArm]);
+    assert_eq!((clip.start, clip.end), (1.0, 8.0));
+    assert!(plan.clone().checked().is_ok());
+    // The segment question asks for clips in its schema.
+    assert!(server.requests()[1]
+        .json()
+        .to_string()
+        .contains("\"clips\""));
+}

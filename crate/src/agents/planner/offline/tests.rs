@@ -599,17 +599,17 @@ fn a_posture_is_held_on_the_arms_over_the_models_squat() {
         Some("a person waves the left hand")
     );
     assert!(v2.segments[1].postures.is_none());
-    // Counted, it is still the model's squat, each with the arms held.
+    // Counted, it is still the model's squat, twice, with the arms held over both as one clip.
     let two = plan_for(
         "a person does two squats with the hands on the hips",
         Some(&v2_vocabulary()),
         None,
     );
     assert_eq!(bases(&two), ["a person does a squat"; 2]);
-    assert!(two.segments.iter().all(|s| s
-        .postures
-        .as_ref()
-        .is_some_and(|t| t.parts == [BodyPart::LeftArm, BodyPart::RightArm])));
+    assert!(two.segments.iter().all(|s| s.postures.is_none()));
+    assert_eq!(two.clips.len(), 1, "{two:#?}");
+    assert_eq!(two.clips[0].parts, [BodyPart::LeftArm, BodyPart::RightArm]);
+    assert_eq!((two.clips[0].start, two.clips[0].end), (0.0, two.seconds()));
 }
 
 #[test]
@@ -733,11 +733,15 @@ fn a_clause_moving_on_to_a_second_movement_keeps_both_and_what_rides_on_them() {
         ["a person walks forward", "a person runs forward"],
         "{p:#?}"
     );
-    for s in &p.segments {
-        let track = s.postures.as_ref().unwrap_or_else(|| panic!("{s:#?}"));
-        assert!(!track.whole_body(), "{track:?}");
-        assert_eq!(track.keys[0].script.name.as_deref(), Some("T-pose"));
-    }
+    // The T-pose is one clip held over the walk and the run, not one per segment.
+    assert!(p.segments.iter().all(|s| s.postures.is_none()), "{p:#?}");
+    assert_eq!(p.clips.len(), 1, "{p:#?}");
+    let clip = &p.clips[0];
+    assert_eq!((clip.start, clip.end), (0.0, p.seconds()));
+    assert_eq!(clip.parts, [BodyPart::LeftArm, BodyPart::RightArm]);
+    let track = clip.postures.as_ref().unwrap();
+    assert_eq!(track.keys[0].script.name.as_deref(), Some("T-pose"));
+    assert_eq!(clip.text, "T-pose");
     // Two whole-body movements at once: one is made, the other named in a note.
     let both = plan("a person dances while walking", None);
     assert_eq!(both.segments.len(), 1);

@@ -65,6 +65,7 @@ fn plan(segments: Vec<Segment>, notes: &[&str]) -> Plan {
         prompt: String::new(),
         rewritten: String::new(),
         segments,
+        clips: Vec::new(),
         planner: PlannerKind::Offline,
         notes: notes.iter().map(|n| n.to_string()).collect(),
     }
