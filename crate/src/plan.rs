@@ -374,22 +374,34 @@ impl Plan {
             return;
         }
         let before = self.segment_starts();
-        let factor = seconds.min(MAX_PLAN_SECONDS) / planned;
+        let target = seconds.min(MAX_PLAN_SECONDS);
+        let factor = target / planned;
         for s in &mut self.segments {
             s.seconds = clamp_seconds(s.seconds * factor).unwrap_or(s.seconds);
         }
-        // Clamping short segments up may overshoot the longest plan: the overshoot comes off
-        // the segments that can give it, in proportion (one pass takes exactly it).
-        if self.seconds() > MAX_PLAN_SECONDS + 1e-6 {
-            let over = self.seconds() - MAX_PLAN_SECONDS;
-            let spare: f64 = self
+        // Segments clamped at a bound cannot take their share: the others scale again for
+        // what is missing, until the length is met or every segment is at its bound.
+        for _ in 0..self.segments.len() {
+            let missing = target - self.seconds();
+            let free = |s: &Segment| {
+                if missing > 0.0 {
+                    s.seconds < MAX_SEGMENT_SECONDS
+                } else {
+                    s.seconds > MIN_SEGMENT_SECONDS
+                }
+            };
+            let adjustable: f64 = self
                 .segments
                 .iter()
-                .map(|s| s.seconds - MIN_SEGMENT_SECONDS)
+                .filter(|s| free(s))
+                .map(|s| s.seconds)
                 .sum();
-            let keep = 1.0 - (over / spare).min(1.0);
-            for s in &mut self.segments {
-                s.seconds = MIN_SEGMENT_SECONDS + (s.seconds - MIN_SEGMENT_SECONDS) * keep;
+            if missing.abs() <= 1e-6 || adjustable <= 0.0 {
+                break;
+            }
+            let factor = 1.0 + missing / adjustable;
+            for s in self.segments.iter_mut().filter(|s| free(s)) {
+                s.seconds = clamp_seconds(s.seconds * factor).unwrap_or(s.seconds);
             }
         }
         let after = self.segment_starts();
@@ -624,6 +636,15 @@ mod tests {
         let planned = three.clone();
         three.fit_seconds(f64::NAN);
         assert_eq!(three, planned);
+        // A segment at its longest leaves its share to the others.
+        let mut capped = planned.clone();
+        capped.segments[0].seconds = 9.0;
+        capped.segments[1].seconds = 2.0;
+        capped.segments[2].seconds = 2.0;
+        capped.fit_seconds(20.0);
+        assert!((capped.seconds() - 20.0).abs() < 1e-9, "{capped:?}");
+        assert_eq!(capped.segments[0].seconds, MAX_SEGMENT_SECONDS);
+        assert!((capped.segments[1].seconds - 5.1).abs() < 1e-9);
         // More than a plan lasts: 60 s, with a note; every segment still one generation.
         three.fit_seconds(90.0);
         assert!((three.seconds() - 29.4).abs() < 1e-9, "{}", three.seconds());

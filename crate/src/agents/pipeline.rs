@@ -806,6 +806,12 @@ mod tests {
             planner: PlannerKind::Offline,
             notes: Vec::new(),
         };
+        // The longest plan's segments, each rounded up to whole steps, still make tokens.
+        let longest: usize = std::iter::repeat_n(2.1, 28)
+            .map(|s| frames_for_seconds(s).div_ceil(FRAMES_PER_TOKEN))
+            .sum();
+        assert_eq!(longest, 308);
+        assert!(MotionTokens::new(vec![vec![vec![0; longest]; 4]; 4]).is_ok());
         // 80 frames = 20 steps, then 42 frames rounded up to 11 steps: 31 steps in all.
         let tokens = MotionTokens::new(vec![vec![vec![0; 31]; 4]; 4]).unwrap();
         assert_eq!(segment_ranges(&plan, &tokens), vec![0..80, 80..124]);

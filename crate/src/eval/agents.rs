@@ -3,7 +3,8 @@
 //! circle is walked.
 
 use crate::agents::llm::UreqTransport;
-use crate::agents::planner::{offline, prompt_set};
+use crate::agents::planner::timeline_set::{self, TimelineFigures};
+use crate::agents::planner::{meaning, offline, prompt_set};
 use crate::executor::block_on;
 use crate::session::{Command, Llm, Outcome, RunOutcome, Session};
 use crate::trajectory::{circle_report, root_path, CircleReport};
@@ -41,6 +42,9 @@ pub struct AgentFigures {
     pub planner: Option<PlannerFigures>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub review: Option<ReviewFigures>,
+    /// The built-in planner on the timeline prompt set, clause by clause.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub timeline: Option<(String, TimelineFigures)>,
     /// "a person walks in a circle clockwise", planned, generated and laid on its path.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub circle: Option<CircleReport>,
@@ -62,6 +66,24 @@ pub fn planner_figures(
         parts_rate: report.parts_rate,
         path_rate: report.path_rate,
     }
+}
+
+/// The built-in planner on the timeline prompt set at `path`, with the session's vocabulary
+/// and sentence encoder (which the clause scorer needs to match by meaning).
+pub fn timeline_figures(
+    session: &Session,
+    path: &std::path::Path,
+) -> anyhow::Result<TimelineFigures> {
+    let set = timeline_set::load(path)?;
+    let embed = |s: &str| session.model().text.encode(&[s])[0].to_vec();
+    let similarity = meaning::embedding_similarity(&embed);
+    let matcher = meaning::Matcher::new(&similarity, meaning::SAME_MOVEMENT_MIN_SIMILARITY);
+    let report = timeline_set::score(
+        &set,
+        &mut |p| offline::plan_for(p, session.vocabulary(), Some(&embed)),
+        &matcher,
+    );
+    Ok(report.figures)
 }
 
 /// One run of the engine with no LLM (built-in planner, evaluator as judge).
@@ -140,6 +162,9 @@ impl AgentFigures {
             None => md.push_str("| trajectory (circle) | not measured (needs SPAM) |\n"),
         }
         md.push_str("\n## Agents\n\n");
+        if let Some((set, t)) = &self.timeline {
+            md.push_str(&t.markdown(set));
+        }
         if let Some(p) = &self.planner {
             md.push_str(&format!(
                 "Built-in planner on the {} prompts of `eval/prompts.json`: segment counts match \

@@ -2,7 +2,9 @@
 //! retrieval baseline, SPAM, SPAM with the review loop), the control probes of the motions
 //! SPAM generates, and the agents' figures, gathered into one [`EvalReport`].
 
-use super::agents::{circle_probe, planner_figures, review_figures, AgentFigures};
+use super::agents::{
+    circle_probe, planner_figures, review_figures, timeline_figures, AgentFigures,
+};
 use super::probes::{
     action, edit_locality, left_right, left_right_legs, quantile, ACTIONS, LOCALITY_BASE,
     LOCALITY_EDIT, LOCALITY_SEEDS,
@@ -27,6 +29,9 @@ pub struct AgentEvalOptions {
     /// The prompt set (e.g. `eval/prompts.json`): prompts with the segments, body-part edits
     /// and paths their motions should have, for the planner and the review loop.
     pub prompts: PathBuf,
+    /// The timeline prompt set (e.g. `eval/timeline_prompts.json`): prompts annotated clause
+    /// by clause, for the planner.
+    pub timeline_prompts: PathBuf,
     /// Review rounds (K) per segment of a reviewed motion; 0 skips the review loop.
     pub review_rounds: usize,
     /// Repetitions of the protocol the spam_review row takes part in.
@@ -76,6 +81,11 @@ pub fn evaluate_agents(
         ..Default::default()
     };
     if let Some(session) = session {
+        log("agents: the timeline prompt set");
+        figures.timeline = Some((
+            options.timeline_prompts.display().to_string(),
+            timeline_figures(session, &options.timeline_prompts)?,
+        ));
         log("agents: the circle probe");
         figures.circle = circle_probe(session, 0)?;
         if options.review_rounds > 0 {

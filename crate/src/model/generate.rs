@@ -107,6 +107,9 @@ fn sample(logits: &[f32], temperature: f32, top_k: Option<usize>, rng: &mut Rng)
     (last as u32, p[last])
 }
 
+/// Fewest masked tokens one unmasking pass of [`Spam::decode_base`] places, on average.
+pub const TOKENS_PER_PASS: usize = 4;
+
 impl Spam {
     /// Fills the masked layer-0 tokens by iterative unmasking. `fixed[p][n]` holds tokens that
     /// must stay (editing); `None` everywhere generates from scratch. Returns `[part][step]`.
@@ -131,7 +134,13 @@ impl Spam {
         for i in &free {
             confidence[*i] = f32::NEG_INFINITY;
         }
-        let iterations = options.iterations.max(1);
+        // A few masked tokens (a blend's transition, a clip's seam) need few passes: each pass
+        // places at least TOKENS_PER_PASS of them, so a transition costs a handful of passes
+        // and not as many as a whole motion.
+        let iterations = options
+            .iterations
+            .min(free.len().div_ceil(TOKENS_PER_PASS))
+            .max(1);
         for it in 0..iterations {
             // Re-mask the least confident free positions, as many as the schedule says.
             let still =

@@ -14,8 +14,10 @@ use serde::{Deserialize, Serialize};
 pub const PARTS: usize = 4;
 /// Most quantizer layers a motion carries.
 pub const MAX_LAYERS: usize = 8;
-/// Most token steps of one motion: the longest plan, 60 s at 20 fps in steps of 4 frames.
-pub const MAX_STEPS: usize = 300;
+/// Most token steps of one motion: the longest plan, 60 s at 20 fps in steps of 4 frames
+/// (300), and one more for each of its up to 30 segments, which are generated in whole steps
+/// and so may each round up by one.
+pub const MAX_STEPS: usize = 330;
 /// Largest code: codes are 9 bits.
 pub const MAX_CODE: u32 = 511;
 

@@ -1,7 +1,7 @@
 //! The plan on the timeline: a bar of the segments in time (each with its text, length and a
 //! Regenerate button, and a mark where each key pose is reached) and, under it, what each asks
 //! for (base motion, body-part edits, path, each key pose's script in words) with its review
-//! scores. While a run is in flight they show its plan, before the motion exists.
+//! scores, and the plan's clips that span segments. While a run is in flight they show its plan, before the motion exists.
 
 use crate::app::{AppState, Pending};
 use crate::take::{plan_segments, Segment};
@@ -20,6 +20,31 @@ pub struct Shown {
     pub scores: Vec<SegmentScores>,
     /// The plan of a run still in flight: nothing to regenerate yet.
     pub preview: bool,
+    /// The plan's clips over spans of their own, one line each ("left arm and right arm,
+    /// 0.0–12.4 s: T-pose").
+    pub clips: Vec<String>,
+}
+
+/// The plan's own clips (not the segments' part instructions, listed under their segment), one
+/// line each.
+fn clip_lines(plan: Option<&coma::plan::Plan>) -> Vec<String> {
+    plan.map(|p| {
+        p.clips
+            .iter()
+            .map(|c| {
+                let parts: Vec<&str> = c.parts.iter().map(|p| p.name()).collect();
+                let held = if c.postures.is_some() { "held: " } else { "" };
+                format!(
+                    "{}, {:.1}–{:.1} s: {held}{}",
+                    parts.join(" and "),
+                    c.start,
+                    c.end,
+                    c.text
+                )
+            })
+            .collect()
+    })
+    .unwrap_or_default()
 }
 
 /// The plan of the run in flight, else the current take's segments.
@@ -32,6 +57,7 @@ pub fn shown_segments(state: AppState) -> Memo<Shown> {
                 segments,
                 scores: Vec::new(),
                 preview: true,
+                clips: clip_lines(Some(&plan)),
             };
         }
         state.history.with(|h| {
@@ -40,6 +66,7 @@ pub fn shown_segments(state: AppState) -> Memo<Shown> {
                 frames: t.frames(),
                 scores: t.scores.clone(),
                 preview: false,
+                clips: clip_lines(t.plan.as_ref()),
             })
         })
     })
@@ -235,6 +262,14 @@ pub fn PlanList(shown: Memo<Shown>) -> impl IntoView {
                             </li>
                         }
                     })
+                    .collect_view()
+            }}
+            {move || {
+                shown
+                    .get()
+                    .clips
+                    .into_iter()
+                    .map(|line| view! { <li class="plan-clip">{format!("clip: {line}")}</li> })
                     .collect_view()
             }}
         </ol>

@@ -63,6 +63,9 @@ pub struct EvalArgs {
     /// Prompt set for the planner and the review loop.
     #[arg(long, default_value = "eval/prompts.json")]
     prompts: PathBuf,
+    /// Timeline prompt set for the planner, scored clause by clause.
+    #[arg(long, default_value = "eval/timeline_prompts.json")]
+    timeline_prompts: PathBuf,
     /// Review rounds (K) of the review loop's measurements (the spam_review row and the
     /// prompt set); 0 skips them.
     #[arg(long, default_value_t = 2)]
@@ -110,6 +113,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
         probe_seeds: args.probe_seeds,
         agents: AgentEvalOptions {
             prompts: args.prompts,
+            timeline_prompts: args.timeline_prompts,
             review_rounds: args.review_rounds,
             review_repeats: args.review_repeats.unwrap_or(args.repeats),
         },

@@ -32,6 +32,10 @@ pub struct PlanArgs {
     /// miss and its reason.
     #[arg(long, conflicts_with_all = ["prompt", "prompts"])]
     timeline_set: Option<PathBuf>,
+    /// With --timeline-set: print the figures as the paragraph `coma eval` writes into
+    /// EVAL.md's agents section.
+    #[arg(long, requires = "timeline_set")]
+    markdown: bool,
     /// Stretch or shrink the plan to about this many seconds (as the page's Seconds field).
     #[arg(long)]
     seconds: Option<f64>,
@@ -51,10 +55,48 @@ pub fn print_plan(plan: &Plan) {
         if let Some(t) = &s.trajectory {
             println!("   path: {}", t.describe());
         }
+        if let Some(track) = &s.postures {
+            println!("   {}", postures_line(track));
+        }
+    }
+    for c in &plan.clips {
+        let parts: Vec<&str> = c.parts.iter().map(|p| p.name()).collect();
+        let held = match &c.postures {
+            Some(track) => format!(", {}", postures_line(track)),
+            None => String::new(),
+        };
+        println!(
+            "clip {:.1}–{:.1} s  {}: {}{held}",
+            c.start,
+            c.end,
+            parts.join(" and "),
+            c.text
+        );
     }
     for n in &plan.notes {
         println!("note: {n}");
     }
+}
+
+/// A posture track in one line: what it drives and its key poses' names.
+fn postures_line(track: &coma::posture::track::PostureTrack) -> String {
+    let names: Vec<&str> = track
+        .keys
+        .iter()
+        .map(|k| k.script.name.as_deref().unwrap_or("posture"))
+        .collect();
+    let on = if track.whole_body() {
+        "key poses".to_string()
+    } else {
+        let parts: Vec<&str> = track.parts.iter().map(|p| p.name()).collect();
+        format!("key poses held on the {}", parts.join(" and "))
+    };
+    let times = if track.repeat > 1 {
+        format!(" ×{}", track.repeat)
+    } else {
+        String::new()
+    };
+    format!("{on}: {}{times}", names.join(", "))
 }
 
 /// One progress line to stderr, when `verbose`.
@@ -142,7 +184,9 @@ pub fn run(args: PlanArgs) -> Result<()> {
             anyhow::bail!("a prompt of the set did not plan: {e}");
         }
         report.planner_seconds = Some(planning.as_secs_f64());
-        if args.json {
+        if args.markdown {
+            print!("{}", report.figures.markdown(&path.display().to_string()));
+        } else if args.json {
             println!("{}", serde_json::to_string_pretty(&report)?);
         } else {
             print!("{}", report.table());

@@ -354,11 +354,12 @@ fn the_report_counts_over_the_set() {
     let set = parse(SET).unwrap();
     let mut plans = vec![plan(vec![walk_waving(BodyPart::RightArm), bow()], &[])].into_iter();
     let report = score(&set, &mut |_| plans.next().unwrap(), &matcher());
-    assert_eq!((report.prompts, report.clauses), (1, 3));
-    assert_eq!(report.correct, 1);
-    assert_eq!(report.side_swaps, 1);
-    assert_eq!(report.silently_lost, 0);
-    assert_eq!(report.prompts_correct, 0);
+    let f = &report.figures;
+    assert_eq!((f.prompts, f.clauses), (1, 3));
+    assert_eq!(f.correct, 1);
+    assert_eq!(f.side_swaps, 1);
+    assert_eq!(f.silently_lost, 0);
+    assert_eq!(f.prompts_correct, 0);
     let table = report.table();
     assert!(table.contains("✗ walk-wave-bow"), "{table}");
     assert!(table.contains("side swapped: left expected"), "{table}");
