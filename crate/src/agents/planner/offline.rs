@@ -4,8 +4,8 @@
 //!    "after that", "finally", "before", "after", a comma or "and" that starts a new verb);
 //!    "while" joins two clauses into one, and so does a comma before "holding", "keeping" or
 //!    "with" (what the body keeps doing rides on the clause). "Before Y, X" and "X after Y"
-//!    are put in time order. Context that is no movement (where, when, why, what the person
-//!    feels) is dropped with a note (the `context` module).
+//!    are put in time order (the `clauses` module). Context that is no movement (where, when,
+//!    why, what the person feels) is dropped with a note (the `context` module).
 //! 2. Each clause gets its movements from [`lexicon`]: one whole-body or walking motion as the
 //!    base, and arm gestures beside it as part edits ("walks forward waving the left hand").
 //!    A clause with no verb inherits the previous clause's gesture ("then the left hand"); a
@@ -16,11 +16,14 @@
 //!    the data uses.
 //! 4. A clause with no known movement is mapped, when an embedder is given, onto the training
 //!    action or the library posture that means the same movement ([`meaning`]: calibrated
-//!    threshold, same side, never the opposite direction), and an arm phrase onto the gesture
-//!    or arm posture it means (the `limbs` module); otherwise it is named in a note.
+//!    threshold, same side, never the opposite direction; the `substitutes` module), and an
+//!    arm phrase onto the gesture or arm posture it means (the `limbs` module); otherwise it
+//!    is named in a note.
 //! 5. Whatever a clause names that no segment makes is named in a note with the reason
 //!    (the `accounting` module): no clause disappears silently. A plan lasts up to
 //!    [`MAX_PLAN_SECONDS`]; clauses past it are named in a note.
+//! 6. A posture or part instruction that runs over several consecutive segments becomes one
+//!    clip on the body-part tracks (the `tracks` module).
 //!
 //! The actions of dataset v2 (squat, jump, lie down, kicks, throw, …) are planned as the
 //! model's own motion only when the model's vocabulary lists them ([`plan_for`]); otherwise,
@@ -41,11 +44,15 @@ use crate::trajectory::{Shape, Trajectory};
 
 mod accounting;
 mod anaphora;
+mod clauses;
 mod context;
 mod limbs;
+mod substitutes;
 mod tracks;
 
-use context::Context;
+use clauses::{clauses, tokens};
+use context::without_context;
+use substitutes::{nearest_action, nearest_library_entry};
 
 /// Turns a sentence into a unit embedding (MiniLM); the planner uses it to map movements it
 /// has no rule for onto the nearest action of the training data.
@@ -447,73 +454,6 @@ fn arms_free(segment: &Segment, arms: &[BodyPart]) -> bool {
     arms.iter().all(|a| segment.parts.get(*a).is_none()) && segment.postures.is_none()
 }
 
-/// The clauses with the context dropped ([`context`]): whole clauses that say where, when,
-/// why or what the person feels, the reasons at the end of a clause ("bows to greet the
-/// guests"), and a clause of no movement and no verb beside a dropped one ("feeling tired
-/// after the marathon" is cut at "after"); each named in a note.
-fn without_context<'a>(
-    clauses: &'a [Vec<String>],
-    known: Repertoire,
-    notes: &mut Vec<String>,
-) -> Vec<Vec<&'a str>> {
-    let clauses: Vec<Vec<&str>> = clauses
-        .iter()
-        .map(|c| c.iter().map(String::as_str).collect())
-        .collect();
-    let moves: Vec<bool> = clauses
-        .iter()
-        .map(|words| {
-            movements(words, None, Reader::alone(known)).is_some()
-                || postures::names_posture(words)
-                || path(words).is_some()
-        })
-        .collect();
-    let kinds: Vec<Option<Context>> = clauses
-        .iter()
-        .zip(&moves)
-        .map(|(words, moves)| context::whole_clause(words, *moves))
-        .collect();
-    let verbless = |k: usize| {
-        !moves[k]
-            && !clauses[k]
-                .iter()
-                .any(|w| lexicon::is_finite_verb(w) || postures::is_posture_verb(w))
-    };
-    let mut out = Vec::new();
-    for (k, words) in clauses.iter().enumerate() {
-        let beside = |j: Option<usize>| j.and_then(|j| kinds.get(j).copied().flatten());
-        let kind = kinds[k].or_else(|| {
-            verbless(k)
-                .then(|| beside(k.checked_sub(1)).or(beside(Some(k + 1))))
-                .flatten()
-        });
-        if let Some(context) = kind {
-            notes.push(format!(
-                "\"{}\" {}; dropped",
-                words.join(" "),
-                context.describe()
-            ));
-            continue;
-        }
-        // "waves the arms to direct traffic" names an action of the data, not a reason.
-        let names_action = |to: usize| {
-            (to + 1..(to + 3).min(words.len())).any(|k| lexicon::dataset_action(words, k).is_some())
-        };
-        match context::reason_tail(words).filter(|&i| !names_action(i)) {
-            Some(i) => {
-                notes.push(format!(
-                    "\"{}\" {}; dropped",
-                    words[i..].join(" "),
-                    Context::Reason.describe()
-                ));
-                out.push(words[..i].to_vec());
-            }
-            None => out.push(words.clone()),
-        }
-    }
-    out
-}
-
 /// The segments' texts as one description ("a person walks forward, then a person bows").
 pub fn rewrite(segments: &[Segment]) -> String {
     segments
@@ -593,286 +533,6 @@ fn repetitions(words: &[&str], found: &Movements, notes: &mut Vec<String>) -> us
         ));
     }
     asked.clamp(1, MAX_SEGMENTS)
-}
-
-/// How a clause starts: a marker that changes its order or merges it with the next one.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Marker {
-    None,
-    /// "before ...": happens after the clause it is attached to, when it leads the sentence.
-    Before,
-    /// "after ...": happens before the clause it follows.
-    After,
-    /// "while ...": at the same time as the next clause.
-    While,
-}
-
-/// A clause and how it joins the one before.
-struct Chunk {
-    words: Vec<String>,
-    marker: Marker,
-    /// Split at "and" with no other connective: undone when the clauses are a walk and a
-    /// gesture ("walks forward and waves"), which happen together.
-    soft: bool,
-}
-
-/// Words and punctuation of the prompt, lower case; hyphens and apostrophes split words.
-fn tokens(text: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut word = String::new();
-    let chars: Vec<char> = text.chars().collect();
-    for (i, &c) in chars.iter().enumerate() {
-        let decimal_point = c == '.'
-            && i > 0
-            && chars[i - 1].is_ascii_digit()
-            && chars.get(i + 1).is_some_and(|n| n.is_ascii_digit());
-        if c.is_alphanumeric() || decimal_point {
-            word.push(c);
-            continue;
-        }
-        if !word.is_empty() {
-            out.push(std::mem::take(&mut word));
-        }
-        match c {
-            ',' | ':' => out.push(",".into()),
-            '.' | ';' | '!' | '?' | '\n' => out.push(".".into()),
-            _ => {}
-        }
-    }
-    if !word.is_empty() {
-        out.push(word);
-    }
-    out
-}
-
-/// True when the words start a new verb phrase, after an optional subject.
-fn starts_verb(words: &[String], known: Repertoire) -> bool {
-    let mut i = 0;
-    // Determiners take a noun, and the noun an adjective or two: "the old man bows".
-    while i < words.len() && i < 4 {
-        let w = words[i].as_str();
-        let next: Vec<&str> = words[i + 1..].iter().take(3).map(String::as_str).collect();
-        let dataset_verb = known.knows_any() && lexicon::is_dataset_verb(w);
-        if (lexicon::is_finite_verb(w) || postures::is_posture_verb(w) || dataset_verb)
-            && !(w == "turn" && next.first() == Some(&"to"))
-        {
-            // "left" after "turn" is part of the verb; a bare side word is not a verb.
-            return action_or_other(w, &next);
-        }
-        if !lexicon::is_subject_word(w) && i > 0 && !lexicon::is_subject_word(&words[i - 1]) {
-            return false;
-        }
-        i += 1;
-    }
-    false
-}
-
-fn action_or_other(word: &str, next: &[&str]) -> bool {
-    match word {
-        "turn" | "turns" => lexicon::action_word(word, next, &[]).is_some(),
-        _ => true,
-    }
-}
-
-/// Cuts the prompt into clauses in time order.
-fn clauses(text: &str, known: Repertoire) -> Vec<Vec<String>> {
-    let tokens = tokens(text);
-    let mut out = Vec::new();
-    for sentence in tokens.split(|t| t == ".") {
-        out.extend(sentence_clauses(sentence, known));
-    }
-    out
-}
-
-fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> {
-    let mut chunks: Vec<Chunk> = vec![Chunk {
-        words: Vec::new(),
-        marker: Marker::None,
-        soft: false,
-    }];
-    let mut i = 0;
-    let word = |k: usize| sentence.get(k).map(String::as_str).unwrap_or("");
-    let new_chunk = |chunks: &mut Vec<Chunk>, marker: Marker, soft: bool| {
-        if chunks.last().is_some_and(|c| c.words.is_empty()) {
-            let last = chunks.last_mut().unwrap();
-            if last.marker == Marker::None {
-                last.marker = marker;
-            }
-            last.soft &= soft;
-        } else {
-            chunks.push(Chunk {
-                words: Vec::new(),
-                marker,
-                soft,
-            });
-        }
-    };
-    while i < sentence.len() {
-        let w = word(i);
-        let rest = &sentence[i + 1..];
-        match w {
-            "," => {
-                let after = rest
-                    .iter()
-                    .position(|t| !matches!(t.as_str(), "and" | "then" | "finally" | ","))
-                    .unwrap_or(rest.len());
-                let connective = rest[..after].iter().any(|t| t == "then" || t == "finally");
-                // "In the rain, a woman hurries …": a sentence that opens with context ends it
-                // at its first comma, whatever the verb after it.
-                let opening: Vec<&str> = sentence[..i].iter().map(String::as_str).collect();
-                let opening = chunks.len() == 1 && context::opens_context(&opening);
-                // "…, holding the T-pose": what the body keeps doing rides on the clause.
-                let rider =
-                    !connective && rest.first().is_some_and(|w| RIDERS.contains(&w.as_str()));
-                if rider {
-                    i += 1;
-                    continue;
-                }
-                if connective
-                    || opening
-                    || starts_verb(&rest[after..], known)
-                    || starts_connective(rest)
-                {
-                    new_chunk(&mut chunks, Marker::None, false);
-                }
-                i += 1;
-                continue;
-            }
-            "then" | "finally" | "afterwards" | "afterward" | "later" | "eventually" => {
-                new_chunk(&mut chunks, Marker::None, false);
-                i += 1;
-                continue;
-            }
-            "next" if starts_verb(rest, known) || rest.first().is_some_and(|t| t == ",") => {
-                new_chunk(&mut chunks, Marker::None, false);
-                i += 1;
-                continue;
-            }
-            "and" => {
-                let skip = rest
-                    .iter()
-                    .take_while(|t| matches!(t.as_str(), "then" | "finally"))
-                    .count();
-                if skip > 0 {
-                    new_chunk(&mut chunks, Marker::None, false);
-                } else if starts_verb(rest, known) {
-                    new_chunk(&mut chunks, Marker::None, true);
-                } else {
-                    chunks.last_mut().unwrap().words.push(w.to_string());
-                }
-                i += 1;
-                continue;
-            }
-            "after" if word(i + 1) == "that" || word(i + 1) == "this" => {
-                new_chunk(&mut chunks, Marker::None, false);
-                i += 2;
-                continue;
-            }
-            "followed" if word(i + 1) == "by" => {
-                new_chunk(&mut chunks, Marker::None, false);
-                i += 2;
-                continue;
-            }
-            "before" => {
-                new_chunk(&mut chunks, Marker::Before, false);
-                i += 1;
-                continue;
-            }
-            "after" => {
-                new_chunk(&mut chunks, Marker::After, false);
-                i += 1;
-                continue;
-            }
-            "while" | "whilst" if chunks.last().is_some_and(|c| c.words.is_empty()) => {
-                chunks.last_mut().unwrap().marker = Marker::While;
-                i += 1;
-                continue;
-            }
-            "first" | "firstly" | "initially" => {
-                i += 1;
-                continue;
-            }
-            _ => {}
-        }
-        chunks.last_mut().unwrap().words.push(w.to_string());
-        i += 1;
-    }
-    chunks.retain(|c| !c.words.is_empty());
-    order(chunks, known)
-}
-
-/// Words that open a phrase of what the body keeps doing during a clause ("…, holding the
-/// T-pose", "…, with both arms raised"): after a comma they ride on the clause before.
-const RIDERS: &[&str] = &["holding", "keeping", "with"];
-
-fn starts_connective(rest: &[String]) -> bool {
-    matches!(
-        rest.first().map(String::as_str),
-        Some("before" | "after" | "afterwards" | "later" | "next")
-    )
-}
-
-/// Puts "before" and "after" clauses in time order, joins "while" clauses and the soft "and"
-/// splits that are one movement.
-fn order(chunks: Vec<Chunk>, known: Repertoire) -> Vec<Vec<String>> {
-    let mut out: Vec<Chunk> = Vec::new();
-    let mut pending_before: Option<Chunk> = None;
-    let mut pending_while: Option<Chunk> = None;
-    for (k, mut chunk) in chunks.into_iter().enumerate() {
-        if let Some(w) = pending_while.take() {
-            let mut words = w.words;
-            words.append(&mut chunk.words);
-            chunk.words = words;
-        }
-        match chunk.marker {
-            Marker::While => {
-                pending_while = Some(chunk);
-                continue;
-            }
-            Marker::Before if k == 0 => {
-                pending_before = Some(chunk);
-                continue;
-            }
-            Marker::After if !out.is_empty() => {
-                let last = out.len() - 1;
-                out.insert(last, chunk);
-                continue;
-            }
-            _ => {}
-        }
-        if chunk.soft {
-            if let Some(last) = out.last_mut() {
-                if soft_join(&last.words, &chunk.words, known) {
-                    last.words.push("and".into());
-                    last.words.append(&mut chunk.words);
-                    continue;
-                }
-            }
-        }
-        out.push(chunk);
-        if let Some(b) = pending_before.take() {
-            out.push(b);
-        }
-    }
-    out.extend(pending_while);
-    out.extend(pending_before);
-    out.into_iter().map(|c| c.words).collect()
-}
-
-/// "walks forward and waves the left hand" is one movement: a walk carrying a gesture.
-fn soft_join(left: &[String], right: &[String], known: Repertoire) -> bool {
-    let l: Vec<&str> = left.iter().map(String::as_str).collect();
-    let r: Vec<&str> = right.iter().map(String::as_str).collect();
-    let reader = Reader::alone(known);
-    let Some(b) = movements(&r, None, reader) else {
-        return false;
-    };
-    let gesture = b.base.is_gesture() && b.gestures.is_empty();
-    // A gesture rides on a walk, or on a posture the model does not know ("kneels and raises
-    // the right hand").
-    let carries = movements(&l, None, reader).is_some_and(|a| a.base.is_locomotion())
-        || postures::names_posture(&l);
-    gesture && carries
 }
 
 /// The movements of one clause; `previous` lends its gesture to a clause with no verb ("then
@@ -1059,80 +719,6 @@ fn prompt_style(text: &str) -> Option<String> {
     tokens(text)
         .iter()
         .find_map(|w| lexicon::style_word(w).map(String::from))
-}
-
-/// A clause of no known movement mapped onto the nearest training action by similarity.
-fn nearest_action(
-    words: &[&str],
-    matcher: Option<&Matcher>,
-    known: Repertoire,
-) -> Option<(Action, f32)> {
-    let matcher = matcher?;
-    if words.is_empty()
-        || !words
-            .iter()
-            .any(|w| lexicon::is_finite_verb(w) || w.len() > 3)
-    {
-        return None;
-    }
-    if words
-        .iter()
-        .all(|w| NOT_MOVEMENT.contains(w) || is_filler(w))
-    {
-        return None;
-    }
-    let clause = format!("a person {}", lexicon::without_subject(words).join(" "));
-    // A substitute must mean the same movement, as the calibrated judgement of
-    // [`meaning`] has it (sides aside, never the opposite direction or gait), and keep the
-    // side the clause names.
-    let side = words
-        .iter()
-        .find_map(|w| side_word(w).filter(|s| *s != Side::Both));
-    // The sided front kicks, where the model knows them, stand for the Bandai kick (as
-    // `dataset_action` reads "kicks").
-    let sided_kicks = known.knows(Action::FrontKick(Side::Right));
-    TRAINING_ACTIONS
-        .iter()
-        .filter(|a| !(sided_kicks && **a == Action::Kick))
-        .chain(lexicon::DATASET_ACTIONS.iter().filter(|a| known.knows(**a)))
-        .map(|a| match side {
-            Some(side) => a.with_side(side),
-            None => *a,
-        })
-        .filter(|a| side.is_none_or(|side| !names_other_side(&a.caption(), side)))
-        .filter_map(|a| matcher.same(&clause, &a.caption()).map(|s| (a, s)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-}
-
-/// A clause of no known movement mapped onto the posture or movement of the library whose
-/// name means the same movement ([`meaning`]), with the similarity: "sits" is "sit on a
-/// chair".
-fn nearest_library_entry(words: &[&str], matcher: Option<&Matcher>) -> Option<(String, f32)> {
-    let matcher = matcher?;
-    if words.is_empty()
-        || words
-            .iter()
-            .all(|w| NOT_MOVEMENT.contains(w) || is_filler(w))
-    {
-        return None;
-    }
-    let clause = format!("a person {}", lexicon::without_subject(words).join(" "));
-    Library::builtin()
-        .all()
-        .filter_map(|n| matcher.same(&clause, n.name()).map(|s| (n.name(), s)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(name, s)| (name.to_string(), s))
-}
-
-/// Whether a caption names the side opposite to `side` and not `side` itself.
-fn names_other_side(caption: &str, side: Side) -> bool {
-    let words: Vec<&str> = caption.split(' ').collect();
-    let (own, other) = match side {
-        Side::Left => ("left", "right"),
-        Side::Right => ("right", "left"),
-        Side::Both => return false,
-    };
-    words.contains(&other) && !words.contains(&own)
 }
 
 /// Verbs of standing still or of no movement at all: a clause of only these is no segment.

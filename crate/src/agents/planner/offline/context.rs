@@ -4,7 +4,9 @@
 //! nearest movement adds one nobody asked for; the built-in planner drops them with a note
 //! that names them and says what they are.
 
-use super::super::lexicon;
+use super::super::lexicon::{self, Repertoire};
+use super::super::postures;
+use super::{movements, path, Reader};
 
 /// What a piece of context says instead of a movement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -173,6 +175,73 @@ pub(super) fn reason_tail(words: &[&str]) -> Option<usize> {
             || words[i] == "because"
             || (words[i] == "in" && words[i + 1..].starts_with(&["order", "to"]))
     })
+}
+
+/// The clauses with the context dropped (this module's readings): whole clauses that say where, when,
+/// why or what the person feels, the reasons at the end of a clause ("bows to greet the
+/// guests"), and a clause of no movement and no verb beside a dropped one ("feeling tired
+/// after the marathon" is cut at "after"); each named in a note.
+pub(super) fn without_context<'a>(
+    clauses: &'a [Vec<String>],
+    known: Repertoire,
+    notes: &mut Vec<String>,
+) -> Vec<Vec<&'a str>> {
+    let clauses: Vec<Vec<&str>> = clauses
+        .iter()
+        .map(|c| c.iter().map(String::as_str).collect())
+        .collect();
+    let moves: Vec<bool> = clauses
+        .iter()
+        .map(|words| {
+            movements(words, None, Reader::alone(known)).is_some()
+                || postures::names_posture(words)
+                || path(words).is_some()
+        })
+        .collect();
+    let kinds: Vec<Option<Context>> = clauses
+        .iter()
+        .zip(&moves)
+        .map(|(words, moves)| whole_clause(words, *moves))
+        .collect();
+    let verbless = |k: usize| {
+        !moves[k]
+            && !clauses[k]
+                .iter()
+                .any(|w| lexicon::is_finite_verb(w) || postures::is_posture_verb(w))
+    };
+    let mut out = Vec::new();
+    for (k, words) in clauses.iter().enumerate() {
+        let beside = |j: Option<usize>| j.and_then(|j| kinds.get(j).copied().flatten());
+        let kind = kinds[k].or_else(|| {
+            verbless(k)
+                .then(|| beside(k.checked_sub(1)).or(beside(Some(k + 1))))
+                .flatten()
+        });
+        if let Some(context) = kind {
+            notes.push(format!(
+                "\"{}\" {}; dropped",
+                words.join(" "),
+                context.describe()
+            ));
+            continue;
+        }
+        // "waves the arms to direct traffic" names an action of the data, not a reason.
+        let names_action = |to: usize| {
+            (to + 1..(to + 3).min(words.len())).any(|k| lexicon::dataset_action(words, k).is_some())
+        };
+        match reason_tail(words).filter(|&i| !names_action(i)) {
+            Some(i) => {
+                notes.push(format!(
+                    "\"{}\" {}; dropped",
+                    words[i..].join(" "),
+                    Context::Reason.describe()
+                ));
+                out.push(words[..i].to_vec());
+            }
+            None => out.push(words.clone()),
+        }
+    }
+    out
 }
 
 #[cfg(test)]
