@@ -473,4 +473,18 @@ fn the_planner_places_movements_by_meaning_and_keeps_sides_and_directions() {
         reaches.segments.iter().all(|s| !s.text.contains("left")),
         "{reaches:#?}"
     );
+    // A clause that names no side gets no substitute with a side of its own: "back to the
+    // centre" after a step to the right is no turn to the right.
+    let centre = offline::plan(
+        "A dancer steps to the left, then steps to the right, then back to the centre.",
+        Some(&embed),
+    );
+    assert!(
+        centre
+            .segments
+            .iter()
+            .skip(2)
+            .all(|s| !s.text.contains("left") && !s.text.contains("right")),
+        "{centre:#?}"
+    );
 }

@@ -104,15 +104,12 @@ pub fn movements(plan: &Plan) -> usize {
 
 /// The body parts a plan edits, sorted by name.
 pub fn edited_parts(plan: &Plan) -> Vec<String> {
+    // Every instruction of the body-part tracks: the segments' own and the plan's clips.
     let mut parts: Vec<String> = plan
-        .segments
+        .part_clips()
         .iter()
-        .flat_map(|s| {
-            s.parts
-                .edits()
-                .into_iter()
-                .map(|(p, _)| p.name().to_string())
-        })
+        .filter(|c| c.postures.is_none())
+        .flat_map(|c| c.parts.iter().map(|p| p.name().to_string()))
         .collect();
     parts.sort();
     parts.dedup();

@@ -45,7 +45,11 @@ pub(super) fn nearest_action(
             Some(side) => a.with_side(side),
             None => *a,
         })
-        .filter(|a| side.is_none_or(|side| !names_other_side(&a.caption(), side)))
+        .filter(|a| match side {
+            Some(side) => !names_other_side(&a.caption(), side),
+            // A side the clause does not name is a movement it does not ask for.
+            None => !names_a_side(&a.caption()),
+        })
         .filter_map(|a| matcher.same(&clause, &a.caption()).map(|s| (a, s)))
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
@@ -71,6 +75,11 @@ pub(super) fn nearest_library_entry(
         .filter_map(|n| matcher.same(&clause, n.name()).map(|s| (n.name(), s)))
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(name, s)| (name.to_string(), s))
+}
+
+/// Whether a caption names a left or right side.
+fn names_a_side(caption: &str) -> bool {
+    caption.split(' ').any(|w| w == "left" || w == "right")
 }
 
 /// Whether a caption names the side opposite to `side` and not `side` itself.
