@@ -360,8 +360,7 @@ async fn blend(
 }
 
 /// The plan's clips that generate motion (not key poses) laid on the blended motion in start
-/// order, each on its parts over its span (see [`MotionModel::edit_parts_span`]), the rest of
-/// the body conditioned on the base motion of the segment under the clip's middle. Clip
+/// order, each on its parts over its span (see [`MotionModel::edit_parts_span`]). Clip
 /// `index` samples with its own seed, so a link's history names it.
 pub async fn lay_clips(
     model: &MotionModel,
@@ -375,20 +374,10 @@ pub async fn lay_clips(
         if clip.postures.is_some() {
             continue;
         }
-        let frames = clip_frames(plan, clip, &tokens);
         let seed = seed_of(run_seed, CLIP_SEED_BASE + index, 0);
-        let rest = &plan.segments[plan.segment_at(clip.middle())].base;
-        tokens = model
-            .edit_parts_span(&tokens, &clip.text, &clip.parts, rest, frames.clone(), seed)
-            .await;
-        history.push(Edit {
-            kind: EditKind::BodyParts,
-            text: clip.text.clone(),
-            from_frame: frames.start as u32,
-            to_frame: frames.end as u32,
-            parts: part_bits(&clip.parts),
-            seed,
-        });
+        let (laid, edit) = lay_clip(model, plan, clip, &tokens, seed).await;
+        tokens = laid;
+        history.push(edit);
         progress(RunEvent::ClipLaid { index, clip });
     }
     tokens
@@ -434,14 +423,7 @@ pub async fn edit_clips(
                 seed,
             )
             .await;
-        edits.push(Edit {
-            kind: EditKind::BodyParts,
-            text: segment.base.clone(),
-            from_frame: frames.start as u32,
-            to_frame: frames.end as u32,
-            parts: part_bits(&clip.parts),
-            seed,
-        });
+        edits.push(clip_edit(&segment.base, &clip.parts, frames, seed));
     }
     let new = after
         .clips
@@ -449,22 +431,48 @@ pub async fn edit_clips(
         .filter(generated)
         .filter(|c| !before.clips.contains(c));
     for (k, clip) in new.enumerate() {
-        let frames = clip_frames(after, clip, &tokens);
-        let rest = &after.segments[after.segment_at(clip.middle())].base;
-        let seed = seed_of(seed, CLIP_SEED_BASE + k, 0);
-        tokens = model
-            .edit_parts_span(&tokens, &clip.text, &clip.parts, rest, frames.clone(), seed)
-            .await;
-        edits.push(Edit {
-            kind: EditKind::BodyParts,
-            text: clip.text.clone(),
-            from_frame: frames.start as u32,
-            to_frame: frames.end as u32,
-            parts: part_bits(&clip.parts),
-            seed,
-        });
+        let (laid, edit) = lay_clip(
+            model,
+            after,
+            clip,
+            &tokens,
+            seed_of(seed, CLIP_SEED_BASE + k, 0),
+        )
+        .await;
+        tokens = laid;
+        edits.push(edit);
     }
     Ok((tokens, edits))
+}
+
+/// One clip that generates motion laid on `tokens` over its span, the rest of the body
+/// conditioned on the base motion of the segment under the clip's middle; with the edit a
+/// link's history records.
+async fn lay_clip(
+    model: &MotionModel,
+    plan: &Plan,
+    clip: &Clip,
+    tokens: &MotionTokens,
+    seed: u64,
+) -> (MotionTokens, Edit) {
+    let frames = clip_frames(plan, clip, tokens);
+    let rest = &plan.segments[plan.segment_at(clip.middle())].base;
+    let laid = model
+        .edit_parts_span(tokens, &clip.text, &clip.parts, rest, frames.clone(), seed)
+        .await;
+    (laid, clip_edit(&clip.text, &clip.parts, frames, seed))
+}
+
+/// The history's record of a body-part edit of `frames`.
+fn clip_edit(text: &str, parts: &[BodyPart], frames: std::ops::Range<usize>, seed: u64) -> Edit {
+    Edit {
+        kind: EditKind::BodyParts,
+        text: text.to_string(),
+        from_frame: frames.start as u32,
+        to_frame: frames.end as u32,
+        parts: part_bits(parts),
+        seed,
+    }
 }
 
 /// Where clips' seeds start in [`seed_of`]'s segment index, past any segment's.

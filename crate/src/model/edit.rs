@@ -39,6 +39,13 @@ pub const SEAM_STEPS: usize = 2;
 /// Steps of context either side of the masked steps when only a window of a motion is filled.
 const WINDOW_CONTEXT_STEPS: usize = 6;
 
+/// The model indices of `parts`, in model order.
+fn part_indices(parts: &[BodyPart]) -> Vec<usize> {
+    (0..PARTS)
+        .filter(|p| parts.contains(&BodyPart::ALL[*p]))
+        .collect()
+}
+
 /// Time steps (of 4 frames) needed for `frames` frames, within the model's range.
 pub fn steps_for_frames(frames: usize, max_steps: usize) -> usize {
     (frames.div_ceil(FRAMES_PER_TOKEN)).clamp(1, max_steps)
@@ -189,9 +196,7 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = tokens[0][0].len();
-        let chosen: Vec<usize> = (0..PARTS)
-            .filter(|p| parts.contains(&BodyPart::ALL[*p]))
-            .collect();
+        let chosen = part_indices(parts);
         let Some(&first) = chosen.first() else {
             return tokens.clone();
         };
@@ -223,9 +228,7 @@ impl Spam {
     ) -> MotionTokens {
         let n = tokens[0][0].len();
         let (a, b) = (steps.start.min(n), steps.end.min(n));
-        let chosen: Vec<usize> = (0..PARTS)
-            .filter(|p| parts.contains(&BodyPart::ALL[*p]))
-            .collect();
+        let chosen = part_indices(parts);
         let Some(&first) = chosen.first() else {
             return tokens.clone();
         };
@@ -293,9 +296,7 @@ impl Spam {
         options: &SamplingOptions,
     ) -> MotionTokens {
         let n = tokens[0][0].len();
-        let chosen: Vec<usize> = (0..PARTS)
-            .filter(|p| parts.contains(&BodyPart::ALL[*p]))
-            .collect();
+        let chosen = part_indices(parts);
         let most = self.base_config.max_steps - 1 - 2 * WINDOW_CONTEXT_STEPS;
         let mut out = tokens.clone();
         let mut start = steps.start.min(n);

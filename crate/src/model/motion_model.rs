@@ -171,11 +171,8 @@ impl MotionModel {
         rest: &str,
         seed: u64,
     ) -> MotionTokens {
-        let edits: Vec<_> = parts
-            .iter()
-            .map(|p| (*p, instruction.to_string()))
-            .collect();
-        self.edit_parts_each(tokens, &edits, rest, seed).await
+        self.edit_parts_each(tokens, &each(parts, instruction), rest, seed)
+            .await
     }
 
     /// Each part of `edits` regenerated from its own instruction, all in one generation (the
@@ -212,17 +209,12 @@ impl MotionModel {
         frames: std::ops::Range<usize>,
         seed: u64,
     ) -> MotionTokens {
-        let edits: Vec<_> = parts
-            .iter()
-            .map(|p| (*p, instruction.to_string()))
-            .collect();
-        let steps = frames.start / FRAMES_PER_TOKEN..frames.end.div_ceil(FRAMES_PER_TOKEN);
         self.spam
             .edit_parts_span(
                 tokens,
-                &self.condition(rest, &edits),
+                &self.condition(rest, &each(parts, instruction)),
                 parts,
-                steps,
+                steps_of(frames),
                 &sampling(seed),
             )
             .await
@@ -240,13 +232,12 @@ impl MotionModel {
         frames: std::ops::Range<usize>,
         seed: u64,
     ) -> MotionTokens {
-        let steps = frames.start / FRAMES_PER_TOKEN..frames.end.div_ceil(FRAMES_PER_TOKEN);
         self.spam
             .regenerate_parts_span(
                 tokens,
                 &self.condition(rest, own),
                 parts,
-                steps,
+                steps_of(frames),
                 &sampling(seed),
             )
             .await
@@ -261,6 +252,19 @@ impl MotionModel {
     pub async fn joints(&self, tokens: &MotionTokens) -> Vec<Pose> {
         features_to_joints(&self.features(tokens).await)
     }
+}
+
+/// The same instruction for each of `parts`.
+fn each(parts: &[BodyPart], instruction: &str) -> Vec<(BodyPart, String)> {
+    parts
+        .iter()
+        .map(|p| (*p, instruction.to_string()))
+        .collect()
+}
+
+/// The token steps that cover `frames` (20 fps).
+fn steps_of(frames: std::ops::Range<usize>) -> std::ops::Range<usize> {
+    frames.start / FRAMES_PER_TOKEN..frames.end.div_ceil(FRAMES_PER_TOKEN)
 }
 
 /// Default sampling with a seed.
