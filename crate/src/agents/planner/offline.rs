@@ -34,11 +34,11 @@ use super::meaning::{self, Matcher};
 use super::postures;
 use crate::dataset::Vocabulary;
 use crate::plan::{
-    clamp_seconds, PartEdits, Plan, PlannerKind, Segment, MAX_PLAN_SECONDS, MAX_SEGMENTS,
-    MAX_TEXT_CHARS,
+    clamp_seconds, in_time_order, PartEdits, Plan, PlannerKind, Segment, MAX_PLAN_SECONDS,
+    MAX_SEGMENTS, MAX_TEXT_CHARS,
 };
-use crate::posture::library::Library;
-use crate::posture::track::PostureTrack;
+use crate::posture::library::{Library, NamedPosture};
+use crate::posture::track::{PostureTrack, DEFAULT_TRANSITION_SECONDS};
 use crate::skeleton::BodyPart;
 use crate::trajectory::{Shape, Trajectory};
 
@@ -46,6 +46,7 @@ mod accounting;
 mod anaphora;
 mod clauses;
 mod context;
+mod limb_poses;
 mod limbs;
 mod substitutes;
 mod tracks;
@@ -121,6 +122,8 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         .collect();
     // The clause each segment came from.
     let mut clause_of: Vec<usize> = Vec::new();
+    // Limb poses read from the words, held over a clause's segments (their indices).
+    let mut held: Vec<(std::ops::Range<usize>, NamedPosture)> = Vec::new();
     for (k, words) in clauses.iter().enumerate() {
         let words = words.as_slice();
         let reader = readers[k];
@@ -192,7 +195,20 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                     }
                 }
                 let made = &mut segments[clause_start..];
-                place_limb_phrases(words, &planned.named, matcher.as_ref(), made, &mut notes);
+                let poses =
+                    place_limb_phrases(words, &planned.named, matcher.as_ref(), made, &mut notes);
+                let span = clause_start..segments.len();
+                held.extend(poses.into_iter().map(|p| (span.clone(), p)));
+                break 'clause;
+            }
+            if let Some((stance, poses)) = model.is_none().then(|| standing_poses(words)).flatten()
+            {
+                // "stands on the left leg while stretching the right leg out behind her".
+                segments.push(stance);
+                let span = clause_start..segments.len();
+                held.extend(poses.into_iter().map(|p| (span.clone(), p)));
+                previous = None;
+                ends_standing = None;
                 break 'clause;
             }
             if let (None, Some(stay)) = (&model, postures::stay(words)) {
@@ -284,7 +300,10 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             // A substitute or an inherited gesture stands for the whole clause.
             if !found.named.is_empty() {
                 let made = &mut segments[clause_start..];
-                place_limb_phrases(words, &found.named, matcher.as_ref(), made, &mut notes);
+                let poses =
+                    place_limb_phrases(words, &found.named, matcher.as_ref(), made, &mut notes);
+                let span = clause_start..segments.len();
+                held.extend(poses.into_iter().map(|p| (span.clone(), p)));
             }
             previous = Some(found.gestures.last().copied().unwrap_or(last));
             ends_standing = Some(last).filter(|a| a.label().is_some() && *a != Action::LieDown);
@@ -328,7 +347,9 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         ));
         segments.truncate(fit);
     }
-    let clips = tracks::clips_across_segments(&mut segments, &clause_of);
+    let mut clips = tracks::clips_across_segments(&mut segments, &clause_of);
+    clips.extend(tracks::held_clips(&segments, &held));
+    in_time_order(&mut clips);
     Plan {
         prompt: prompt.to_string(),
         rewritten: rewrite(&segments),
@@ -402,19 +423,34 @@ fn moves_on(
     out
 }
 
-/// Places each phrase of a clause about an arm in which the rules read no movement on the
-/// clause's segments (`made`), as the gesture or arm posture it means ([`limbs`]), where
-/// those arms are free; names it in a note otherwise, and names every leg phrase (`named`:
-/// the words that named a movement).
+/// Places each phrase of a clause about a limb in which the rules read no movement on the
+/// clause's segments (`made`): a place the limb holds ("with his right arm upwards",
+/// [`limb_poses`]) is returned, to be held on the limb's track over those segments; an arm
+/// phrase that says no place is the gesture or arm posture it means ([`limbs`]), where those
+/// arms are free. What cannot be placed is named in a note (`named`: the words that named a
+/// movement).
 fn place_limb_phrases(
     words: &[&str],
     named: &[usize],
     matcher: Option<&Matcher>,
     made: &mut [Segment],
     notes: &mut Vec<String>,
-) {
+) -> Vec<NamedPosture> {
+    let mut held: Vec<NamedPosture> = Vec::new();
     for (phrase, limb) in accounting::limb_phrases_without_movement(words, named) {
         let phrase_words: Vec<&str> = phrase.split(' ').collect();
+        if let Some(pose) = limb_poses::limb_pose(&phrase_words) {
+            let taken = held
+                .iter()
+                .any(|h| h.parts.iter().any(|p| pose.parts.contains(p)));
+            match made.iter().find_map(|s| busy(s, &pose.parts)).or_else(|| {
+                (made.is_empty() || taken).then_some("another phrase of the clause moves it")
+            }) {
+                None => held.push(pose),
+                Some(why) => notes.push(format!("\"{phrase}\" {NOT_PLACED}: {why}")),
+            }
+            continue;
+        }
         let found = matcher
             .filter(|_| limb == "arm")
             .and_then(|m| limbs::nearest_arm_movement(&phrase_words, m));
@@ -446,6 +482,91 @@ fn place_limb_phrases(
             movement.describe()
         ));
     }
+    held
+}
+
+/// A clause that only says where limbs are ([`limb_poses`]): the body stands, on one leg if
+/// the clause says so (the segment's own posture), and the other places are held on their
+/// limbs over it. `None` when no limb phrase of the clause reads as a place.
+fn standing_poses(words: &[&str]) -> Option<(Segment, Vec<NamedPosture>)> {
+    let mut poses: Vec<NamedPosture> = Vec::new();
+    for (phrase, _) in accounting::limb_phrases_without_movement(words, &[]) {
+        let phrase: Vec<&str> = phrase.split(' ').collect();
+        if let Some(pose) = limb_poses::limb_pose(&phrase) {
+            poses.push(pose);
+        }
+    }
+    if poses.is_empty() {
+        return None;
+    }
+    let legs = [BodyPart::LeftLeg, BodyPart::RightLeg];
+    let stance = poses
+        .iter()
+        .position(|p| legs.iter().all(|l| p.parts.contains(l)))
+        .map(|k| poses.remove(k));
+    // Each limb held once: the first place a phrase gives it.
+    let mut kept: Vec<NamedPosture> = Vec::new();
+    for pose in poses {
+        if kept
+            .iter()
+            .all(|k| k.parts.iter().all(|p| !pose.parts.contains(p)))
+        {
+            kept.push(pose);
+        }
+    }
+    let (text, postures) = match &stance {
+        Some(s) => (
+            format!("a person {}", s.name.replacen("standing", "stands", 1)),
+            Some(PostureTrack::holding(s.parts.clone(), s.script.clone())),
+        ),
+        None => ("a person stands still".to_string(), None),
+    };
+    let seconds = postures
+        .as_ref()
+        .and_then(|t| clamp_seconds(t.natural_seconds() + DEFAULT_TRANSITION_SECONDS))
+        .unwrap_or(2.0)
+        .max(2.0);
+    Some((
+        Segment {
+            text,
+            seconds,
+            base: "a person stands still".into(),
+            parts: PartEdits::default(),
+            trajectory: None,
+            postures,
+        },
+        kept,
+    ))
+}
+
+/// Why a segment cannot have a pose held on `parts` over it, if it cannot: an instruction or
+/// a held posture of its own moves them, or (for a leg) the body travels or jumps on its legs.
+/// A posture of the whole body (a spin of key poses) carries a held arm.
+fn busy(segment: &Segment, parts: &[BodyPart]) -> Option<&'static str> {
+    if parts.iter().any(|p| segment.parts.get(*p).is_some()) {
+        return Some("another instruction of the clause moves that limb");
+    }
+    let legs = parts
+        .iter()
+        .any(|p| matches!(p, BodyPart::LeftLeg | BodyPart::RightLeg));
+    match &segment.postures {
+        Some(track) if track.whole_body() && legs => {
+            Some("a posture of the whole body already holds the legs")
+        }
+        Some(track) if !track.whole_body() && track.parts.iter().any(|p| parts.contains(p)) => {
+            Some("a posture of the clause already holds that limb")
+        }
+        _ if legs && !stands(segment) => {
+            Some("the legs carry the movement of the clause and cannot also hold a pose")
+        }
+        _ => None,
+    }
+}
+
+/// Whether a segment's base motion stands in place (the legs are free to hold a pose).
+fn stands(segment: &Segment) -> bool {
+    let base = segment.base.as_str();
+    base.contains("stands") && !base.contains("up")
 }
 
 /// Whether a segment leaves `arms` to a movement of their own: no instruction and no posture

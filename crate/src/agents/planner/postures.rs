@@ -178,6 +178,36 @@ fn library_names(action: Action) -> &'static [&'static str] {
     }
 }
 
+/// Whether the words right after a library mention say it is about a limb the posture does
+/// not hold: "stretching **the right leg** out" is no "stretching arms up".
+fn names_other_limb(after: &str, named: &Named) -> bool {
+    let Named::Posture(posture) = named else {
+        return false;
+    };
+    let limb = after
+        .split(' ')
+        .filter(|w| !w.is_empty())
+        .take(3)
+        .find_map(|w| match w {
+            "leg" | "legs" | "foot" | "feet" | "knee" | "knees" => Some(true),
+            "arm" | "arms" | "hand" | "hands" => Some(false),
+            _ => None,
+        });
+    let holds_legs = posture
+        .parts
+        .iter()
+        .any(|p| matches!(p, BodyPart::LeftLeg | BodyPart::RightLeg));
+    let holds_arms = posture
+        .parts
+        .iter()
+        .any(|p| matches!(p, BodyPart::LeftArm | BodyPart::RightArm));
+    match limb {
+        Some(true) => !holds_legs,
+        Some(false) => !holds_arms,
+        None => false,
+    }
+}
+
 /// Whether a clause only names poses that `action`, planned next, passes through
 /// ("kneels and then lies down": the model's lying down kneels on the way).
 pub fn leads_into(words: &[&str], action: Action) -> bool {
@@ -520,6 +550,7 @@ pub fn plan_clause(
         !plain_raise
             && !phrase.split(' ').any(|w| model_words.contains(&w))
             && !passed.contains(&named.name())
+            && !names_other_limb(&text[range.end..], named)
     });
     if mentions.is_empty() {
         return None;
@@ -587,6 +618,12 @@ pub fn plan_clause(
     let mut track = match &action {
         Some((_, a)) => {
             let mut track = a.track(count, direction(words));
+            // The library turns to the left; "spins to the right" turns the other way.
+            if turns_right(words) {
+                for key in &mut track.keys {
+                    key.turn_deg = -key.turn_deg;
+                }
+            }
             if let Some(arms) = merge_arms(&arm_postures, &mut notes) {
                 for key in &mut track.keys {
                     match with_arms(&key.script, &arms) {
@@ -706,6 +743,20 @@ pub fn on_arm(posture: &NamedPosture, arm: Option<BodyPart>) -> NamedPosture {
                 script,
             }
         }
+        // A posture of one arm says which when the clause does ("salutes with the right hand").
+        (Some(arm), [own])
+            if *own == arm && !posture.name.contains("left") && !posture.name.contains("right") =>
+        {
+            let name = format!("{} with the {}", posture.name, arm.name());
+            let mut script = posture.script.clone();
+            script.name = Some(name.clone());
+            NamedPosture {
+                name,
+                synonyms: posture.synonyms.clone(),
+                parts: vec![arm],
+                script,
+            }
+        }
         _ => posture.clone(),
     }
 }
@@ -776,15 +827,46 @@ fn repetitions(words: &[&str], text: &str, action_at: Option<usize>) -> Option<u
 /// and nowhere when it names no direction.
 fn direction(words: &[&str]) -> [f64; 2] {
     let has = |w: &[&str]| words.iter().any(|x| w.contains(x));
+    let sideways = has(&["sideways", "aside"]);
     if has(&["forward", "forwards", "ahead", "across"]) {
         [0.0, 1.0]
     } else if has(&["backward", "backwards"]) {
         [0.0, -1.0]
-    } else if has(&["sideways", "aside"]) && has(&["left"]) {
+    } else if (sideways && has(&["left"])) || toward(words, "left") {
         [1.0, 0.0]
-    } else if has(&["sideways", "aside"]) && has(&["right"]) {
+    } else if (sideways && has(&["right"])) || toward(words, "right") {
         [-1.0, 0.0]
     } else {
         [0.0, 0.0]
     }
+}
+
+/// Whether the words go toward `side` ("to the left", "towards his right", "leftward"), not
+/// only name a limb of that side ("with the left hand").
+fn toward(words: &[&str], side: &str) -> bool {
+    let ward = format!("{side}ward");
+    let wards = format!("{side}wards");
+    words.iter().any(|w| *w == ward || *w == wards)
+        || words.windows(3).any(|w| {
+            matches!(w[0], "to" | "towards" | "toward")
+                && matches!(w[1], "the" | "his" | "her" | "their")
+                && w[2] == side
+        })
+        || words
+            .windows(2)
+            .any(|w| matches!(w[0], "to" | "towards" | "toward") && w[1] == side)
+}
+
+/// Whether a turning movement goes to the right (clockwise seen from above): the words say
+/// "to the right", "clockwise" or "rightward"; the library's turns go to the left.
+fn turns_right(words: &[&str]) -> bool {
+    let counter = words.iter().any(|w| {
+        matches!(
+            *w,
+            "counterclockwise" | "anticlockwise" | "counter-clockwise" | "anti-clockwise"
+        )
+    }) || words
+        .windows(2)
+        .any(|w| matches!(w[0], "counter" | "anti") && w[1] == "clockwise");
+    !counter && (toward(words, "right") || words.contains(&"clockwise"))
 }

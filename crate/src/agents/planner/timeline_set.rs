@@ -31,15 +31,17 @@
 //! it.
 //!
 //! **Matching by meaning.** A clause's words (or its `means`, for anaphora) and an element's
-//! text (with its path, if it walks one) are matched as [`super::meaning`] decides whether
-//! two texts are the same movement: MiniLM similarity at least
-//! [`SAME_MOVEMENT_MIN_SIMILARITY`](super::meaning::SAME_MOVEMENT_MIN_SIMILARITY) (calibrated on hand-labelled pairs, as that module
-//! says), sides aside, and no opposite directions or gaits.
+//! text (with its path, if it walks one; for a posture of the library, also the library's
+//! other words for it: "T-pose" is "arms out to the sides") are matched as [`super::meaning`]
+//! decides whether two texts are the same movement: MiniLM similarity at least
+//! [`SAME_MOVEMENT_MIN_SIMILARITY`](super::meaning::SAME_MOVEMENT_MIN_SIMILARITY) (calibrated
+//! on hand-labelled pairs, as that module says), sides aside, and no opposite directions or
+//! gaits.
 //!
 //! Each plan element accounts for one clause. Among all ways to match clauses to elements
-//! above the threshold, the scorer keeps the one with the most clauses placed, then the most
-//! placed correctly, then the highest total similarity: what the plan holds is found (a
-//! clause out of order is misplaced, not lost), it is read as favourably as it allows, and a
+//! above the threshold, the scorer keeps the one with the most clauses placed correctly, then
+//! the most placed, then the highest total similarity: it is read as favourably as it allows,
+//! what else the plan holds is found (a clause out of order is misplaced, not lost), and a
 //! plan that says something once is not counted for two clauses.
 
 use super::meaning::{words, Matcher, OPPOSITES};
@@ -66,6 +68,10 @@ pub const PATHS: [&str; 9] = [
 /// Seconds two elements must share to overlap, and one must start before another to come
 /// first: less than a frame is the same instant.
 const TIME_EPS: f64 = 0.05;
+
+/// How much closer an element must be to another clause of the prompt than to this one to be
+/// read as that clause's only (MiniLM cosine similarity).
+const CLEARLY_OTHER: f32 = 0.15;
 
 /// Candidate elements kept per clause (the most similar), to bound the search.
 const MAX_CANDIDATES: usize = 4;
@@ -384,6 +390,11 @@ pub struct Element {
     /// The segment it belongs to (identical elements of consecutive segments repeat a
     /// movement).
     pub segment: usize,
+    /// The posture library's other words for what a posture track holds ("arms out to the
+    /// sides" for its "T-pose"): a person reading the plan knows the name means them, so the
+    /// meaning match reads them too.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub aliases: Vec<String>,
 }
 
 impl Element {
@@ -399,6 +410,15 @@ impl Element {
             Some(p) => format!("{}, along {p}", self.text),
             None => self.text.clone(),
         }
+    }
+
+    /// How much it means `clause`'s movement, by its words or the library's other words for
+    /// it; `None` below the matcher's threshold.
+    pub fn means(&self, clause: &str, matcher: &Matcher) -> Option<f32> {
+        std::iter::once(self.said())
+            .chain(self.aliases.iter().cloned())
+            .filter_map(|t| matcher.same(clause, &t))
+            .max_by(f32::total_cmp)
     }
 
     fn describe(&self) -> String {
@@ -484,6 +504,7 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
                 count: text_count(&s.base),
                 path: s.trajectory.as_ref().map(|t| t.describe()),
                 segment: k,
+                aliases: Vec::new(),
             });
         }
         if let Some(track) = &s.postures {
@@ -493,6 +514,8 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
             };
             let names = distinct_names(track.keys.iter().map(|k| &k.script));
             let text = library_movement(&names).unwrap_or_else(|| names.join(", "));
+            let aliases = library_words(&text, &names);
+            let text = format!("{text}{}", way(track));
             let mut parts = track.parts.clone();
             parts.sort();
             out.push(Element {
@@ -512,17 +535,19 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
                     .filter(|_| posture_body)
                     .map(|t| t.describe()),
                 segment: k,
+                aliases,
             });
         }
     }
     for clip in &plan.clips {
-        let (text, count) = match &clip.postures {
+        let (text, count, aliases) = match &clip.postures {
             Some(track) => {
                 let names = distinct_names(track.keys.iter().map(|k| &k.script));
                 let text = library_movement(&names).unwrap_or_else(|| names.join(", "));
-                (text, track.repeat.max(1))
+                let aliases = library_words(&text, &names);
+                (text, track.repeat.max(1), aliases)
             }
-            None => (clip.text.clone(), text_count(&clip.text)),
+            None => (clip.text.clone(), text_count(&clip.text), Vec::new()),
         };
         out.push(Element {
             on: On::Parts(clip.parts.clone()),
@@ -532,6 +557,7 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
             count,
             path: None,
             segment: plan.segment_at(clip.start),
+            aliases,
         });
     }
     // In time order, the whole body first: as a person reads a timeline.
@@ -540,6 +566,29 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
             .total_cmp(&b.start)
             .then((a.on != On::Body).cmp(&(b.on != On::Body)))
     });
+    out
+}
+
+/// Which way a track turns or travels sideways, as its numbers say (", turning to the
+/// right"), so the side is read from what the plan does; empty when it does neither.
+fn way(track: &crate::posture::track::PostureTrack) -> String {
+    let turn: f64 = track.keys.iter().map(|k| k.turn_deg).sum();
+    let left: f64 = track.keys.iter().map(|k| k.travel[0]).sum();
+    let mut out = String::new();
+    if turn.abs() > 1.0 {
+        out += if turn > 0.0 {
+            ", turning to the left"
+        } else {
+            ", turning to the right"
+        };
+    }
+    if left.abs() > 1e-3 {
+        out += if left > 0.0 {
+            ", to the left"
+        } else {
+            ", to the right"
+        };
+    }
     out
 }
 
@@ -564,6 +613,23 @@ fn library_movement(names: &[String]) -> Option<String> {
         .iter()
         .find(|a| distinct_names(a.keys.iter().map(|k| &k.script)) == names)
         .map(|a| a.name.clone())
+}
+
+/// The library's other words for a posture track named `text` (a library movement) or
+/// holding the key poses `names`: the movement's phrases, or, for a track of one key pose,
+/// the posture's (a track of several poses is the sequence, which no one phrase says).
+fn library_words(text: &str, names: &[String]) -> Vec<String> {
+    let library = Library::builtin();
+    if let Some(action) = library.actions.iter().find(|a| a.name == text) {
+        return action.phrases().skip(1).collect();
+    }
+    match names {
+        [one] => library
+            .get(one)
+            .map(|p| p.phrases().skip(1).collect())
+            .unwrap_or_default(),
+        _ => Vec::new(),
+    }
 }
 
 /// Why a clause is not placed correctly.
@@ -1042,13 +1108,14 @@ struct Search<'p, 'a> {
     best: Option<(Score, Vec<Option<usize>>)>,
 }
 
-/// What the search maximises, in order: every clause the plan holds is placed (a clause is
-/// not left out to spare another an order miss), then as many as can be are right, then the
+/// What the search maximises, in order: as many clauses right as the plan allows (as a
+/// person reads it: "raise the right fist" is the clause that says so, even where another
+/// clause could also be read into it), then every other clause the plan holds placed, then the
 /// closest meaning, then the whole of a repeated run taken.
 #[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
 struct Score {
-    placed: usize,
     correct: usize,
+    placed: usize,
     similarity: f32,
     elements: usize,
 }
@@ -1062,8 +1129,8 @@ impl Search<'_, '_> {
         let bad = self.own_bad.iter().filter(|b| **b).count();
         let correct_bound = p.movement.len() - bad - self.matching;
         if let Some((best, _)) = &self.best {
-            if placed_bound < best.placed
-                || (placed_bound == best.placed && correct_bound < best.correct)
+            if correct_bound < best.correct
+                || (correct_bound == best.correct && placed_bound < best.placed)
             {
                 return;
             }
@@ -1245,6 +1312,18 @@ pub fn score_prompt(p: &SetPrompt, plan: &Plan, matcher: &Matcher) -> PromptOutc
         .filter(|&i| clauses[i].track != Track::None)
         .collect();
     movement.sort_by_key(|&i| (clauses[i].order, i));
+    // How well each element means the clause it means best: an element that plainly says one
+    // clause is not read as another it only resembles (a T-pose is no "run").
+    let best_of: Vec<f32> = elements
+        .iter()
+        .map(|e| {
+            clauses
+                .iter()
+                .filter(|c| c.track != Track::None)
+                .filter_map(|c| e.means(c.meaning(), matcher))
+                .fold(f32::MIN, f32::max)
+        })
+        .collect();
     let choices: Vec<Vec<Choice>> = clauses
         .iter()
         .map(|c| {
@@ -1254,7 +1333,8 @@ pub fn score_prompt(p: &SetPrompt, plan: &Plan, matcher: &Matcher) -> PromptOutc
             let mut starts: Vec<(usize, f32)> = elements
                 .iter()
                 .enumerate()
-                .filter_map(|(k, e)| matcher.same(c.meaning(), &e.said()).map(|s| (k, s)))
+                .filter_map(|(k, e)| e.means(c.meaning(), matcher).map(|s| (k, s)))
+                .filter(|(k, s)| *s >= best_of[*k] - CLEARLY_OTHER)
                 .collect();
             starts.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
             starts.truncate(MAX_CANDIDATES);
@@ -1337,7 +1417,7 @@ pub fn score_prompt(p: &SetPrompt, plan: &Plan, matcher: &Matcher) -> PromptOutc
                     .iter()
                     .enumerate()
                     .filter(|(k, _)| !claimed[*k])
-                    .find_map(|(_, e)| matcher.same(c.meaning(), &e.said()).map(|s| (e, Some(s))))
+                    .find_map(|(_, e)| e.means(c.meaning(), matcher).map(|s| (e, Some(s))))
                     .or_else(|| {
                         let note = note.as_deref()?;
                         note_pieces(note)

@@ -799,23 +799,35 @@ fn settings_reasons_and_states_are_dropped_with_a_note() {
 
 #[test]
 fn every_movement_a_clause_names_is_placed_or_named_in_a_note() {
-    // No rule (and no sentence encoder here) for these arms: named, with the reason.
+    // Where the arms are is held on their tracks over the spin, each on its own side.
     let p = plan(
         "He spins while having his right arm upwards and the left arm extended forward.",
         None,
     );
-    for phrase in [
-        "having his right arm upwards",
-        "the left arm extended forward",
-    ] {
-        assert!(
-            p.notes
-                .iter()
-                .any(|n| n.contains(&format!("\"{phrase}\"")) && n.contains(NOT_PLACED)),
-            "{phrase}: {:?}",
-            p.notes
-        );
-    }
+    let held: Vec<(Vec<BodyPart>, &str)> = p
+        .clips
+        .iter()
+        .map(|c| (c.parts.clone(), c.text.as_str()))
+        .collect();
+    assert_eq!(
+        held,
+        [
+            (vec![BodyPart::LeftArm], "left arm straight forward"),
+            (vec![BodyPart::RightArm], "right arm up"),
+        ],
+        "{p:#?}"
+    );
+    assert!(p.clips.iter().all(|c| c.end == p.segments[0].seconds));
+    // A movement of an arm with no rule (and no sentence encoder here): named, with the
+    // reason.
+    let p = plan("He spins with his left arm flapping.", None);
+    assert!(
+        p.notes
+            .iter()
+            .any(|n| n.contains("\"with his left arm flapping\"") && n.contains(NOT_PLACED)),
+        "{:?}",
+        p.notes
+    );
     // A knee lifted is no hand raised.
     let knee = plan("A person lifts the right knee up high.", None);
     assert!(

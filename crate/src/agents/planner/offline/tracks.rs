@@ -4,8 +4,11 @@
 //! two squats), not as one copy per segment that lets go and takes hold again at each join.
 
 use crate::plan::{in_time_order, Clip, Segment};
+use crate::posture::library::NamedPosture;
 use crate::posture::script::PostureScript;
+use crate::posture::track::PostureTrack;
 use crate::skeleton::BodyPart;
+use std::ops::Range;
 
 /// Takes the held postures and part instructions that run unchanged over two or more
 /// consecutive segments off those segments and returns them as clips over the whole run.
@@ -84,6 +87,31 @@ pub fn clips_across_segments(segments: &mut [Segment], clause_of: &[usize]) -> V
     }
     in_time_order(&mut clips);
     clips
+}
+
+/// The limb poses read from a clause's words ([`super::limb_poses`]) as clips holding them,
+/// each over the segments its clause made (`held`: their indices; those past the plan's end
+/// are gone with them).
+pub fn held_clips(segments: &[Segment], held: &[(Range<usize>, NamedPosture)]) -> Vec<Clip> {
+    let mut starts = vec![0.0];
+    for s in segments {
+        starts.push(starts.last().copied().unwrap_or(0.0) + s.seconds);
+    }
+    held.iter()
+        .filter_map(|(range, pose)| {
+            let end = range.end.min(segments.len());
+            (range.start < end).then(|| Clip {
+                parts: pose.parts.clone(),
+                text: pose.name.clone(),
+                start: starts[range.start],
+                end: starts[end],
+                postures: Some(PostureTrack::holding(
+                    pose.parts.clone(),
+                    pose.script.clone(),
+                )),
+            })
+        })
+        .collect()
 }
 
 /// The names of key poses in order, each once, as a clip's text ("T-pose").
