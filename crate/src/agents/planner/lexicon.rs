@@ -333,7 +333,9 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
         | "wandering" | "pace" | "paces" | "pacing" | "steps" | "stepping" => {
             Action::Walk(Direction::Forward)
         }
-        "turn" | "turns" | "turning" | "turned" => {
+        // "walks forward, turning left" walks; "turns to the left" on its own is the key-pose
+        // library's turn on the spot.
+        "turning" => {
             if near(next, &["left"]) || prev.last() == Some(&"left") {
                 Action::Walk(Direction::TurnLeft)
             } else if near(next, &["right", "around"]) || prev.last() == Some(&"right") {
@@ -844,6 +846,8 @@ pub fn is_finite_verb(word: &str) -> bool {
         "kneels",
         "spin",
         "spins",
+        "turn",
+        "turns",
         "sit",
         "sits",
         "rest",

@@ -413,6 +413,14 @@ pub fn names_posture(words: &[&str]) -> bool {
         .any(|(_, n)| matches!(n, Named::Posture(p) if !arms_only(p)))
 }
 
+/// Whether a clause names a movement of the key-pose library ("turns to the left", "spins").
+pub fn names_movement(words: &[&str]) -> bool {
+    Library::builtin()
+        .mentions(&words.join(" "))
+        .iter()
+        .any(|(_, n)| matches!(n, Named::Action(_)))
+}
+
 /// Which part of the body a constraint is about, to merge two postures (a squat's legs with a
 /// T-pose's arms).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -868,5 +876,11 @@ fn turns_right(words: &[&str]) -> bool {
     }) || words
         .windows(2)
         .any(|w| matches!(w[0], "counter" | "anti") && w[1] == "clockwise");
-    !counter && (toward(words, "right") || words.contains(&"clockwise"))
+    let turn_right = words.windows(2).any(|w| {
+        matches!(
+            w[0],
+            "turn" | "turns" | "turning" | "spin" | "spins" | "spinning" | "twirls" | "pivots"
+        ) && w[1] == "right"
+    });
+    !counter && (toward(words, "right") || turn_right || words.contains(&"clockwise"))
 }

@@ -81,7 +81,22 @@ fn starts_verb(words: &[String], known: Repertoire) -> bool {
 
 fn action_or_other(word: &str, next: &[&str]) -> bool {
     match word {
-        "turn" | "turns" => lexicon::action_word(word, next, &[]).is_some(),
+        // "turns left", "turns around": a turn of the body ("takes turns" is none).
+        "turn" | "turns" => matches!(
+            next.first(),
+            Some(
+                &("left"
+                    | "right"
+                    | "around"
+                    | "round"
+                    | "back"
+                    | "to"
+                    | "toward"
+                    | "towards"
+                    | "sideways"
+                    | "away")
+            )
+        ),
         _ => true,
     }
 }

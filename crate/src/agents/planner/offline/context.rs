@@ -195,6 +195,7 @@ pub(super) fn without_context<'a>(
         .map(|words| {
             movements(words, None, Reader::alone(known)).is_some()
                 || postures::names_posture(words)
+                || postures::names_movement(words)
                 || path(words).is_some()
         })
         .collect();
