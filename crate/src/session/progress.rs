@@ -132,8 +132,9 @@ mod tests {
         assert_eq!(lines.len(), 2 + 3);
         assert!(lines[1].starts_with("plan: 3 segment(s)"), "{}", lines[1]);
         assert!(lines[2].contains("left arm ← "), "{}", lines[2]);
-        // Generate, one left-arm edit, two reviews; two × (generate, two reviews); blend.
-        assert_eq!(run_steps(&plan, 2), 4 + 3 + 3 + 1);
+        // Generate, one left-arm edit, two reviews; the turn on the spot (key poses, not
+        // reviewed); the bow (generate, two reviews); blend.
+        assert_eq!(run_steps(&plan, 2), 4 + 1 + 3 + 1);
         assert_eq!(run_steps(&offline::plan("a person bows", None), 0), 1);
     }
 

@@ -179,20 +179,23 @@ fn library_names(action: Action) -> &'static [&'static str] {
 }
 
 /// Whether the words right after a library mention say it is about a limb the posture does
-/// not hold: "stretching **the right leg** out" is no "stretching arms up".
-fn names_other_limb(after: &str, named: &Named) -> bool {
+/// not hold: "stretching **the right leg** out" is no "stretching arms up", nor is
+/// "stretches out **his right arm**".
+fn names_other_limb(after: &str, one_word: bool, named: &Named) -> bool {
     let Named::Posture(posture) = named else {
         return false;
     };
-    let limb = after
-        .split(' ')
-        .filter(|w| !w.is_empty())
-        .take(3)
-        .find_map(|w| match w {
-            "leg" | "legs" | "foot" | "feet" | "knee" | "knees" => Some(true),
-            "arm" | "arms" | "hand" | "hands" => Some(false),
-            _ => None,
-        });
+    let next: Vec<&str> = after.split(' ').filter(|w| !w.is_empty()).take(4).collect();
+    let limb = next.iter().find_map(|w| match *w {
+        "leg" | "legs" | "foot" | "feet" | "knee" | "knees" => Some(true),
+        "arm" | "arms" | "hand" | "hands" => Some(false),
+        _ => None,
+    });
+    // "stretches out his right arm": a bare verb the words after complete, about one arm;
+    // the limb's own words say where it goes.
+    if one_word && one_arm_after(after).is_some() {
+        return true;
+    }
     let holds_legs = posture
         .parts
         .iter()
@@ -206,6 +209,49 @@ fn names_other_limb(after: &str, named: &Named) -> bool {
         Some(false) => !holds_arms,
         None => false,
     }
+}
+
+/// The one arm the words right after a mention name ("… with the left hand"), if they name
+/// one arm.
+fn one_arm_after(after: &str) -> Option<BodyPart> {
+    let next: Vec<&str> = after.split(' ').filter(|w| !w.is_empty()).take(4).collect();
+    let arm = next.iter().any(|w| matches!(*w, "arm" | "hand" | "fist"));
+    match (arm, next.contains(&"left"), next.contains(&"right")) {
+        (true, true, false) => Some(BodyPart::LeftArm),
+        (true, false, true) => Some(BodyPart::RightArm),
+        _ => None,
+    }
+}
+
+/// A posture of both arms held by `arm` alone: its constraints on that arm (and none on the
+/// other), named for it; `None` when it says nothing of that arm alone.
+fn one_arm_of(posture: &NamedPosture, arm: BodyPart) -> Option<NamedPosture> {
+    use crate::skeleton::joint;
+    let other = match arm {
+        BodyPart::LeftArm => [joint::R_SHOULDER, joint::R_ELBOW, joint::R_WRIST],
+        _ => [joint::L_SHOULDER, joint::L_ELBOW, joint::L_WRIST],
+    };
+    let constraints: Vec<Constraint> = posture
+        .script
+        .constraints
+        .iter()
+        .filter(|c| region(c) == Region::Arms && !c.joints().iter().any(|j| other.contains(j)))
+        .copied()
+        .collect();
+    let name = format!("{} with the {}", posture.name, arm.name());
+    let script = PostureScript {
+        name: Some(name.clone()),
+        hold: posture.script.hold,
+        constraints,
+    }
+    .check()
+    .ok()?;
+    Some(NamedPosture {
+        name,
+        synonyms: posture.synonyms.clone(),
+        parts: vec![arm],
+        script,
+    })
 }
 
 /// Whether a clause only names poses that `action`, planned next, passes through
@@ -501,6 +547,31 @@ fn with_arms(base: &PostureScript, arms: &PostureScript) -> Option<PostureScript
     .ok()
 }
 
+/// The arms of a whole-body posture as a posture of their own (its name kept: the boxer's
+/// guard is still "boxing stance"); `None` when it says nothing of the arms.
+fn arms_of(p: &NamedPosture) -> Option<NamedPosture> {
+    let constraints: Vec<Constraint> = p
+        .script
+        .constraints
+        .iter()
+        .filter(|c| region(c) == Region::Arms)
+        .copied()
+        .collect();
+    let script = PostureScript {
+        name: p.script.name.clone(),
+        hold: p.script.hold,
+        constraints,
+    }
+    .check()
+    .ok()?;
+    Some(NamedPosture {
+        name: p.name.clone(),
+        synonyms: p.synonyms.clone(),
+        parts: vec![BodyPart::LeftArm, BodyPart::RightArm],
+        script,
+    })
+}
+
 fn arms_only(p: &NamedPosture) -> bool {
     p.parts
         .iter()
@@ -558,7 +629,7 @@ pub fn plan_clause(
         !plain_raise
             && !phrase.split(' ').any(|w| model_words.contains(&w))
             && !passed.contains(&named.name())
-            && !names_other_limb(&text[range.end..], named)
+            && !names_other_limb(&text[range.end..], !phrase.contains(' '), named)
     });
     if mentions.is_empty() {
         return None;
@@ -570,8 +641,14 @@ pub fn plan_clause(
     let arm = arm_side(words);
     let postures: Vec<NamedPosture> = mentions
         .iter()
-        .filter_map(|(_, n)| match n {
-            Named::Posture(p) => Some(on_arm(p, arm)),
+        .filter_map(|(r, n)| match n {
+            Named::Posture(p) => Some(
+                // "reaches up high with the left hand": the posture of both arms, on one.
+                match one_arm_after(&text[r.end..]).filter(|_| p.parts.len() == 2 && arms_only(p)) {
+                    Some(one) => one_arm_of(p, one).unwrap_or_else(|| on_arm(p, arm)),
+                    None => on_arm(p, arm),
+                },
+            ),
             Named::Action(_) => None,
         })
         .collect();
@@ -604,6 +681,19 @@ pub fn plan_clause(
         })
         .unwrap_or_default();
 
+    // A walk or a run keeps its legs: a posture of the whole body named beside it lends it
+    // only its arms ("shuffles backward, keeping his guard up" walks in a boxer's guard).
+    let travels = model.is_some_and(|(base, _)| base.is_locomotion());
+    let lent: Vec<NamedPosture> = body_postures
+        .iter()
+        .filter(|_| travels && action.is_none())
+        .filter_map(|p| arms_of(p))
+        .collect();
+    let (arm_postures, body_postures) = if lent.is_empty() {
+        (arm_postures, body_postures)
+    } else {
+        (arm_postures.into_iter().chain(&lent).collect(), Vec::new())
+    };
     // The model's walk, run or squat, with the arms held in a posture.
     if carries_arms && action.is_none() && body_postures.is_empty() {
         let mut segment = model_segment();
@@ -670,7 +760,18 @@ pub fn plan_clause(
                     }
                 }
             }
-            let mut track = PostureTrack::holding(BodyPart::ALL.to_vec(), script);
+            // A posture of the arms alone is held on the arms while the body stands (the
+            // model's standing, not a statue); one of the whole body is the whole body.
+            let parts = if body_postures.is_empty() {
+                let mut arms: Vec<BodyPart> =
+                    arm_postures.iter().flat_map(|p| p.parts.clone()).collect();
+                arms.sort();
+                arms.dedup();
+                arms
+            } else {
+                BodyPart::ALL.to_vec()
+            };
+            let mut track = PostureTrack::holding(parts, script);
             if let Some(n) = count.filter(|n| *n > 1) {
                 track.repeat = n;
                 track.returns = true;

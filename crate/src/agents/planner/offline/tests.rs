@@ -664,7 +664,10 @@ const PLANNED_BEFORE_V2: &[(&str, &[Recorded])] = &[
     ("throws a ball", &[("throws a ball", &[])]),
     (
         "reaches up high with the left hand",
-        &[("a person stands still", &["stretching arms up"])],
+        &[(
+            "a person stands still",
+            &["stretching arms up with the left arm"],
+        )],
     ),
     ("sneaks forward", &[("sneaks forward", &[])]),
     (
