@@ -532,7 +532,7 @@ mod tests {
     #[test]
     fn planned_segments_lie_where_the_pipeline_puts_them() {
         let plan = coma::agents::planner::offline::plan(
-            "A person walks forward waving the left hand, then turns right and bows",
+            "A person walks forward waving the left hand, then walks on turning right and bows",
             None,
         );
         // 4 + 5 + 3 s of token steps, as blended.
@@ -585,7 +585,7 @@ mod tests {
     #[test]
     fn a_named_posture_goes_into_the_segment_where_its_range_starts() {
         let plan = coma::agents::planner::offline::plan(
-            "A person walks forward waving the left hand, then turns right and bows",
+            "A person walks forward waving the left hand, then walks on turning right and bows",
             None,
         );
         let tokens = coma::model::tokens::MotionTokens::new(vec![vec![vec![0; 60]; 1]; 4]).unwrap();
@@ -639,7 +639,7 @@ mod tests {
     /// A take of the three-segment plan, walking 0.05 m a frame (1 m/s).
     fn walking_take() -> Take {
         let plan = coma::agents::planner::offline::plan(
-            "A person walks forward waving the left hand, then turns right and bows",
+            "A person walks forward waving the left hand, then walks on turning right and bows",
             None,
         );
         let tokens = coma::model::tokens::MotionTokens::new(vec![vec![vec![0; 60]; 1]; 4]).unwrap();

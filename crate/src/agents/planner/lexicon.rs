@@ -57,6 +57,8 @@ pub enum Action {
     Bow,
     Kick,
     Punch,
+    /// A punch with one hand ("throws a left punch", as the Bandai Namco captions say it).
+    PunchWith(Side),
     Slash,
     Dance,
     Beckon,
@@ -243,6 +245,7 @@ impl Action {
             Action::Bow => "bows".into(),
             Action::Kick => "kicks forward with a leg".into(),
             Action::Punch => "throws punches".into(),
+            Action::PunchWith(side) => format!("throws a {} punch", side.one()),
             Action::Slash => "slashes as if with a sword".into(),
             Action::Dance => "dances".into(),
             Action::Beckon => "beckons someone to come".into(),
@@ -296,7 +299,7 @@ impl Action {
             Action::Run => 3.5,
             Action::Dash => 3.0,
             Action::Dance => 6.0,
-            Action::Kick | Action::Punch => 2.5,
+            Action::Kick | Action::Punch | Action::PunchWith(_) => 2.5,
             // Dataset v2 (`data/coma/dataset.json`): the median length of the label's items
             // that are whole clips (not windows of a longer one), frames at 20 fps.
             Action::Squat => 1.5,
@@ -320,6 +323,26 @@ impl Action {
             Action::JogCircle(_) => 2.0,
             _ => 3.0,
         }
+    }
+}
+
+/// The hand a punch is thrown with: "a left punch", "punches with the right fist"; `None`
+/// for both or none.
+fn punch_side(next: &[&str], prev: &[&str]) -> Option<Side> {
+    let side = |w: &str| match w {
+        "left" => Some(Side::Left),
+        "right" => Some(Side::Right),
+        _ => None,
+    };
+    if let Some(s) = prev.first().and_then(|w| side(w)) {
+        return Some(s);
+    }
+    let near: Vec<&str> = next.iter().take(4).copied().collect();
+    let hand = near.iter().any(|w| matches!(*w, "hand" | "fist" | "arm"));
+    let sides: Vec<Side> = near.iter().filter_map(|w| side(w)).collect();
+    match sides.as_slice() {
+        [one] if hand => Some(*one),
+        _ => None,
     }
 }
 
@@ -350,7 +373,14 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
         }
         "bow" | "bows" | "bowing" | "bowed" => Action::Bow,
         "kick" | "kicks" | "kicking" | "kicked" => Action::Kick,
-        "punch" | "punches" | "punching" | "punched" | "boxes" | "boxing" => Action::Punch,
+        "hook" | "hooks" if prev.first().is_some_and(|w| matches!(*w, "left" | "right")) => {
+            punch_side(next, prev).map_or(Action::Punch, Action::PunchWith)
+        }
+        "punch" | "punches" | "punching" | "punched" | "boxes" | "boxing" | "jab" | "jabs"
+        | "uppercut" | "uppercuts" => match punch_side(next, prev) {
+            Some(side) => Action::PunchWith(side),
+            None => Action::Punch,
+        },
         "slash" | "slashes" | "slashing" | "slashed" | "sword" => Action::Slash,
         "dance" | "dances" | "dancing" | "danced" => Action::Dance,
         "beckon" | "beckons" | "beckoning" | "calls" => Action::Beckon,

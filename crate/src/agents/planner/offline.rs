@@ -235,6 +235,16 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 }
                 break 'clause;
             }
+            if let Some(once_more) = model
+                .is_none()
+                .then(|| anaphora::again(words))
+                .flatten()
+                .and_then(|a| anaphora::repeated(segments.last()?, a))
+            {
+                // "waves with the left hand, then with the right".
+                segments.push(once_more);
+                break 'clause;
+            }
             if let Some(lowered) = model
                 .is_none()
                 .then(|| lowered_back(words, segments.last()))

@@ -1,8 +1,11 @@
 //! Clauses that point back at the movement before them: "raises her right arm and then
 //! **lowers it**", "lifts both hands, then **puts them down**". Read alone they name no
 //! movement (and the nearest one by meaning may be the opposite); read against the segment
-//! before, they bring down the arms it raised.
+//! before, they bring down the arms it raised. A clause that only points back ("does it
+//! again", "then with the right", "the other one") makes that movement once more, on the side
+//! it names.
 
+use super::super::lexicon::Side;
 use crate::plan::Segment;
 use crate::skeleton::BodyPart;
 
@@ -67,6 +70,118 @@ pub(super) fn raised_arms(segment: &Segment) -> Vec<BodyPart> {
     }
 }
 
+/// What a clause that only points back asks of the movement before it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Again {
+    /// The same movement once more ("does it again", "repeats it").
+    Same,
+    /// The same movement with the other side ("then with the other hand", "the other one").
+    Other,
+    /// The same movement on a side it names ("then with the right", "the left one too").
+    On(Side),
+}
+
+/// Words an elliptical clause may hold besides its side ("then with the right one too").
+const FILLER: &[&str] = &[
+    "with", "the", "his", "her", "their", "its", "then", "and", "one", "hand", "arm", "foot",
+    "leg", "fist", "side", "too", "also", "now", "same", "on", "using", "a", "person", "he", "she",
+    "they", "someone", "it", "again", "does", "do", "did", "repeats", "repeat", "same", "thing",
+    "once", "more", "over", "this", "time", "switches", "switch", "to",
+];
+
+/// Whether a clause only points back at the movement before ("does it again", "with the
+/// right", "then the other one"), and how; `None` when it names anything else.
+pub(super) fn again(words: &[&str]) -> Option<Again> {
+    if words.is_empty() || words.iter().any(|w| !FILLER.contains(w) && !is_side(w)) {
+        return None;
+    }
+    let repeats = words
+        .iter()
+        .any(|w| matches!(*w, "again" | "repeats" | "repeat" | "same"))
+        || words.windows(2).any(|w| w == ["once", "more"]);
+    let side = words.iter().find_map(|w| match *w {
+        "left" => Some(Again::On(Side::Left)),
+        "right" => Some(Again::On(Side::Right)),
+        "other" => Some(Again::Other),
+        _ => None,
+    });
+    match side {
+        Some(s) => Some(s),
+        None if repeats => Some(Again::Same),
+        None => None,
+    }
+}
+
+fn is_side(word: &str) -> bool {
+    matches!(word, "left" | "right" | "other")
+}
+
+/// The side a segment moves one limb of, by its words and parts; `None` for both or none.
+fn side_of(segment: &Segment) -> Option<Side> {
+    let mut texts = vec![segment.base.clone()];
+    texts.extend(segment.parts.edits().into_iter().map(|(_, t)| t));
+    if let Some(track) = &segment.postures {
+        texts.extend(track.keys.iter().filter_map(|k| k.script.name.clone()));
+    }
+    let all = texts.join(" ");
+    let has = |side: &str| all.split(' ').any(|w| w == side);
+    match (has("left"), has("right")) {
+        (true, false) => Some(Side::Left),
+        (false, true) => Some(Side::Right),
+        _ => None,
+    }
+}
+
+/// `segment` made once more as `again` asks; `None` when a side is asked of a movement that
+/// has none.
+pub(super) fn repeated(segment: &Segment, again: Again) -> Option<Segment> {
+    let own = side_of(segment);
+    let mirror = match (again, own) {
+        (Again::Same, _) => false,
+        (Again::Other, Some(_)) => true,
+        (Again::On(want), Some(own)) => want != own,
+        (Again::Other | Again::On(_), None) => return None,
+    };
+    Some(if mirror {
+        mirrored(segment)
+    } else {
+        segment.clone()
+    })
+}
+
+/// A segment with its left and right swapped: the words, the part instructions and the key
+/// poses.
+fn mirrored(segment: &Segment) -> Segment {
+    let swap = |text: &str| {
+        text.split(' ')
+            .map(|w| match w {
+                "left" => "right",
+                "right" => "left",
+                other => other,
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut out = segment.clone();
+    out.text = swap(&segment.text);
+    out.base = swap(&segment.base);
+    let mut parts = crate::plan::PartEdits::default();
+    for (part, text) in segment.parts.edits() {
+        parts.set(part.mirrored(), Some(swap(&text)));
+    }
+    out.parts = parts;
+    if let Some(track) = &mut out.postures {
+        track.parts = track.parts.iter().map(|p| p.mirrored()).collect();
+        for key in &mut track.keys {
+            key.script = key.script.mirrored();
+            key.script.name = key.script.name.as_deref().map(swap);
+            key.turn_deg = -key.turn_deg;
+            key.travel[0] = -key.travel[0];
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,5 +198,45 @@ mod tests {
         assert_eq!(raised_arms(&raised.segments[0]), [BodyPart::LeftArm]);
         let walk = plan("a person walks forward", None);
         assert!(raised_arms(&walk.segments[0]).is_empty());
+    }
+
+    fn words(text: &str) -> Vec<&str> {
+        text.split(' ').collect()
+    }
+
+    #[test]
+    fn a_clause_that_points_back_repeats_the_movement_on_the_side_it_names() {
+        assert_eq!(again(&words("does it again")), Some(Again::Same));
+        assert_eq!(
+            again(&words("then with the right")),
+            Some(Again::On(Side::Right))
+        );
+        assert_eq!(again(&words("the other one")), Some(Again::Other));
+        assert_eq!(
+            again(&words("does it again with the right")),
+            Some(Again::On(Side::Right))
+        );
+        assert_eq!(again(&words("walks again")), None);
+        assert_eq!(
+            again(&words("with the right hand")),
+            Some(Again::On(Side::Right))
+        );
+        let wave = Segment {
+            text: "a person waves the left hand".into(),
+            seconds: 3.0,
+            base: "a person waves the left hand".into(),
+            parts: Default::default(),
+            trajectory: None,
+            postures: None,
+        };
+        let right = repeated(&wave, Again::On(Side::Right)).unwrap();
+        assert_eq!(right.base, "a person waves the right hand");
+        assert_eq!(repeated(&wave, Again::On(Side::Left)).unwrap(), wave);
+        assert_eq!(repeated(&wave, Again::Other).unwrap(), right);
+        let bow = Segment {
+            base: "a person bows".into(),
+            ..wave.clone()
+        };
+        assert_eq!(repeated(&bow, Again::Other), None);
     }
 }

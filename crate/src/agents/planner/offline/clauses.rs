@@ -5,7 +5,7 @@
 
 use super::super::lexicon::{self, Repertoire};
 use super::super::postures;
-use super::{context, movements, Reader};
+use super::{anaphora, context, movements, Reader};
 
 /// How a clause starts: a marker that changes its order or merges it with the next one.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,6 +77,22 @@ fn starts_verb(words: &[String], known: Repertoire) -> bool {
         i += 1;
     }
     false
+}
+
+/// True when the words up to the next comma or "and" only point back at the movement before
+/// ("… and one with the right", "…, then the other hand") or name it again on one side ("…, a
+/// right hook"): a clause of their own, made from the one before.
+fn points_back(words: &[String]) -> bool {
+    let end = words
+        .iter()
+        .position(|w| matches!(w.as_str(), "," | "and" | "then"))
+        .unwrap_or(words.len());
+    let chunk: Vec<&str> = words[..end].iter().map(String::as_str).collect();
+    let sided_noun = matches!(
+        chunk.as_slice(),
+        ["a" | "an" | "one", "left" | "right", _, ..]
+    );
+    !chunk.is_empty() && (anaphora::again(&chunk).is_some() || sided_noun)
 }
 
 fn action_or_other(word: &str, next: &[&str]) -> bool {
@@ -159,6 +175,7 @@ fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> 
                     || opening
                     || starts_verb(&rest[after..], known)
                     || starts_connective(rest)
+                    || points_back(&rest[after..])
                 {
                     new_chunk(&mut chunks, Marker::None, false);
                 }
@@ -184,6 +201,8 @@ fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> 
                     new_chunk(&mut chunks, Marker::None, false);
                 } else if starts_verb(rest, known) {
                     new_chunk(&mut chunks, Marker::None, true);
+                } else if points_back(rest) {
+                    new_chunk(&mut chunks, Marker::None, false);
                 } else {
                     chunks.last_mut().unwrap().words.push(w.to_string());
                 }
