@@ -161,6 +161,41 @@ pub const FACE_JOINTS: [usize; 4] = [
     joint::L_SHOULDER,
 ];
 
+/// The character's own left or right: of a limb, of what a hand touches, of a turn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Side {
+    Left,
+    Right,
+}
+
+impl Side {
+    /// The word for it ("left").
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+
+    /// The other side.
+    pub fn other(self) -> Side {
+        match self {
+            Side::Left => Side::Right,
+            Side::Right => Side::Left,
+        }
+    }
+
+    /// The side a word names ("left", "right").
+    pub fn of_word(word: &str) -> Option<Side> {
+        match word {
+            "left" => Some(Side::Left),
+            "right" => Some(Side::Right),
+            _ => None,
+        }
+    }
+}
+
 /// The four body parts the model and the user work with. Parts overlap, as in CoMA: the torso
 /// belongs to both upper parts and the pelvis to both lower parts.
 #[derive(

@@ -49,6 +49,7 @@ use crate::plan::Plan;
 use crate::posture::library::Library;
 use crate::posture::script::PostureScript;
 use crate::skeleton::BodyPart;
+pub use crate::skeleton::Side;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -136,23 +137,6 @@ impl Track {
             Track::LeftArm | Track::LeftLeg => Some(Side::Left),
             Track::RightArm | Track::RightLeg => Some(Side::Right),
             _ => None,
-        }
-    }
-}
-
-/// Left or right.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Side {
-    Left,
-    Right,
-}
-
-impl Side {
-    fn name(self) -> &'static str {
-        match self {
-            Side::Left => "left",
-            Side::Right => "right",
         }
     }
 }

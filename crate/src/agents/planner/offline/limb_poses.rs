@@ -14,48 +14,17 @@ use crate::posecodes::Support;
 use crate::posecodes::{Bend, BodyPoint, Distance, Limb, Orientation, PelvisLevel, Relation};
 use crate::posture::library::NamedPosture;
 use crate::posture::script::{Constraint, Hinge, PostureScript};
-use crate::skeleton::BodyPart;
+use crate::skeleton::{BodyPart, Side};
 
 /// Seconds a read pose is held once reached when the clause does not say (the clip's span
 /// holds it anyway).
 const HOLD_SECONDS: f64 = 1.0;
 
-/// Left or right, of a limb or of what it touches.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Side {
-    Left,
-    Right,
-}
-
-impl Side {
-    fn name(self) -> &'static str {
-        match self {
-            Side::Left => "left",
-            Side::Right => "right",
-        }
-    }
-
-    fn other(self) -> Side {
-        match self {
-            Side::Left => Side::Right,
-            Side::Right => Side::Left,
-        }
-    }
-
-    /// The relation "further out on this side".
-    fn outward(self) -> Relation {
-        match self {
-            Side::Left => Relation::LeftOf,
-            Side::Right => Relation::RightOf,
-        }
-    }
-
-    fn of_word(word: &str) -> Option<Side> {
-        match word {
-            "left" => Some(Side::Left),
-            "right" => Some(Side::Right),
-            _ => None,
-        }
+/// The relation "further out on this side".
+fn outward(side: Side) -> Relation {
+    match side {
+        Side::Left => Relation::LeftOf,
+        Side::Right => Relation::RightOf,
     }
 }
 
@@ -520,7 +489,7 @@ fn arm_constraints(side: Side, place: Place) -> Vec<Constraint> {
             orient(upper, Orientation::Horizontal),
             orient(fore, Orientation::Horizontal),
             rel(hand, shoulder, Relation::LevelWith),
-            rel(hand, shoulder, side.outward()),
+            rel(hand, shoulder, outward(side)),
         ],
         Place::Down => vec![
             bend(Bend::Straight),
@@ -541,7 +510,7 @@ fn arm_constraints(side: Side, place: Place) -> Vec<Constraint> {
             bend(Bend::Straight),
             rel(elbow_point, shoulder, Relation::Above),
             rel(hand, BodyPoint::Head, Relation::Above),
-            rel(hand, shoulder, side.outward()),
+            rel(hand, shoulder, outward(side)),
         ],
         Place::On(t) => {
             let point = |s: Option<Side>, left, right, own| match s {
@@ -670,44 +639,26 @@ fn leg_pose(phrase: &[&str], at: usize, sides: &[Side]) -> Option<NamedPosture> 
             "up", "raised", "raises", "raise", "lifts", "lifted", "lift", "high", "air", "off",
         ],
     );
+    // A straight leg lifted off the floor toward `from`'s `way`.
+    let straight = |from: BodyPoint, way: Relation| {
+        vec![
+            off,
+            bend(Bend::Straight),
+            rel(foot_point, from, way),
+            Constraint::Orientation {
+                limb: thigh,
+                is: Orientation::Diagonal,
+            },
+        ]
+    };
     let (what, constraints) = if behind {
-        (
-            "out behind",
-            vec![
-                off,
-                bend(Bend::Straight),
-                rel(foot_point, BodyPoint::Pelvis, Relation::Behind),
-                Constraint::Orientation {
-                    limb: thigh,
-                    is: Orientation::Diagonal,
-                },
-            ],
-        )
+        ("out behind", straight(BodyPoint::Pelvis, Relation::Behind))
     } else if out {
-        (
-            "out to the side",
-            vec![
-                off,
-                bend(Bend::Straight),
-                rel(foot_point, hip, side.outward()),
-                Constraint::Orientation {
-                    limb: thigh,
-                    is: Orientation::Diagonal,
-                },
-            ],
-        )
+        ("out to the side", straight(hip, outward(side)))
     } else if forward {
         (
             "straight forward",
-            vec![
-                off,
-                bend(Bend::Straight),
-                rel(foot_point, BodyPoint::Pelvis, Relation::InFrontOf),
-                Constraint::Orientation {
-                    limb: thigh,
-                    is: Orientation::Diagonal,
-                },
-            ],
+            straight(BodyPoint::Pelvis, Relation::InFrontOf),
         )
     } else if up || noun == "knee" {
         (
