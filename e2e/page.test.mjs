@@ -753,6 +753,9 @@ test("a 60-second prompt of nine clauses plays on the CPU backend, and its clips
 
     // The T-pose's end dragged back to 4 s: key poses, no generation, the arms let go earlier.
     const tEnd = page.locator('.clip-track[data-part="left arm"] .clip .clip-end.end').first();
+    // The panel above may have grown (a plan's key poses listed), so the track can sit out
+    // of view: a drag starts where a person can grab it.
+    await tEnd.scrollIntoViewIfNeeded();
     const track = await page.locator('.clip-track[data-part="left arm"]').boundingBox();
     const endBox = await tEnd.boundingBox();
     await page.mouse.move(endBox.x + endBox.width / 2, endBox.y + endBox.height / 2);
