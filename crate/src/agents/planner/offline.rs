@@ -66,6 +66,9 @@ pub const LEFT_OUT: &str = "names no movement the model makes; left out";
 /// How a note says no rule read a clause at all (a gap in the rules, never expected: the
 /// prompt sets' test fails on it).
 pub const UNREAD: &str = "was read by no rule of the built-in planner; left out";
+/// How a note says a clause was made as a movement the model knows that says it in other
+/// words, not plainly the same ("sidesteps to the right" as "a person walks to the right").
+pub const MADE_AS: &str = "is made as the nearest movement the model knows";
 /// How a note says a part of a clause was left out of the plan (the reason follows).
 pub const NOT_PLACED: &str = "was left out of the plan";
 
@@ -278,6 +281,7 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                     break 'clause;
                 }
             }
+            let from_rules = model.is_some();
             let found = match model {
                 Some(found) => found,
                 None => match action.flatten() {
@@ -299,6 +303,9 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 },
             };
             let made = segment(words, &found, style.as_deref());
+            if from_rules {
+                notes.extend(said_otherwise(words, &made, matcher.as_ref()));
+            }
             for _ in 0..repetitions(words, &found, &mut notes) {
                 segments.push(made.clone());
             }
@@ -952,6 +959,25 @@ fn segment(words: &[&str], found: &Movements, style: Option<&str>) -> Segment {
         trajectory,
         postures: None,
     }
+}
+
+/// The note for a clause whose segment does not plainly mean what its words say, by the same
+/// judgement the timeline set's scorer uses ([`meaning`]): the rules read the clause's verb
+/// and its direction, and drop what they have no word for ("jogs **in place**", "walks **to
+/// the door**"), so the person is told what stands for their words. Only the clause's head
+/// is compared (up to the first phrase that rides on it: "…, holding the T-pose" is placed on
+/// its own).
+fn said_otherwise(words: &[&str], made: &Segment, matcher: Option<&Matcher>) -> Option<String> {
+    let matcher = matcher?;
+    let head = accounting::head_phrase(&lexicon::without_subject(words));
+    if head.is_empty() || matcher.same(&head, &made.text).is_some() {
+        return None;
+    }
+    Some(format!(
+        "\"{}\" {MADE_AS}: \"{}\"",
+        words.join(" "),
+        made.text
+    ))
 }
 
 /// "for 3 seconds", "for 2.5 s", "for five seconds".

@@ -185,7 +185,16 @@ fn names_other_limb(after: &str, one_word: bool, named: &Named) -> bool {
     let Named::Posture(posture) = named else {
         return false;
     };
-    let next: Vec<&str> = after.split(' ').filter(|w| !w.is_empty()).take(4).collect();
+    // Only the mention's own words: "kneels on one knee **while waving both hands**" is a
+    // kneel with a movement of the arms beside it.
+    let next: Vec<&str> = after
+        .split(' ')
+        .filter(|w| !w.is_empty())
+        .take(4)
+        .take_while(|w| {
+            !matches!(*w, "while" | "whilst" | "and" | "," | "then" | "as") && !w.ends_with("ing")
+        })
+        .collect();
     let limb = next.iter().find_map(|w| match *w {
         "leg" | "legs" | "foot" | "feet" | "knee" | "knees" => Some(true),
         "arm" | "arms" | "hand" | "hands" => Some(false),

@@ -28,7 +28,7 @@ const SEQUENCE_WORDS: &[&str] = &[
 ];
 
 /// Limb nouns and the limb they name, for the notes.
-fn limb(word: &str) -> Option<&'static str> {
+pub(super) fn limb(word: &str) -> Option<&'static str> {
     Some(match word {
         "arm" | "arms" | "hand" | "hands" | "fist" | "fists" | "elbow" | "elbows" | "palm"
         | "palms" | "finger" | "fingers" | "wrist" | "wrists" => "arm",
@@ -69,6 +69,15 @@ pub(super) fn phrase_from(words: &[&str], at: usize) -> String {
         .unwrap_or(words.len())
         .min(at + 8);
     words[at.min(words.len())..end].join(" ")
+}
+
+/// The words of a clause up to the first boundary or opener, the movement it names before
+/// what rides on it ("walks calmly" of "walks calmly with the right hand raised").
+pub(super) fn head_phrase(words: &[&str]) -> String {
+    let end = (1..words.len())
+        .find(|&k| BOUNDARIES.contains(&words[k]) || OPENERS.contains(&words[k]))
+        .unwrap_or(words.len());
+    words[..end].join(" ")
 }
 
 /// Whether the words between the movement named at `first` and the one at `second` put the

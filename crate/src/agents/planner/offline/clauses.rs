@@ -5,7 +5,7 @@
 
 use super::super::lexicon::{self, Repertoire};
 use super::super::postures;
-use super::{anaphora, context, movements, Reader};
+use super::{accounting, anaphora, context, movements, Reader};
 
 /// How a clause starts: a marker that changes its order or merges it with the next one.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,12 +71,54 @@ fn starts_verb(words: &[String], known: Repertoire) -> bool {
             // "left" after "turn" is part of the verb; a bare side word is not a verb.
             return action_or_other(w, &next);
         }
+        if unknown_verb(w, next.first().copied()) {
+            return true;
+        }
         if !lexicon::is_subject_word(w) && i > 0 && !lexicon::is_subject_word(&words[i - 1]) {
             return false;
         }
         i += 1;
     }
     false
+}
+
+/// A word that is a verb wherever it stands ("turns" in "turns his head").
+fn is_verb(word: &str, known: Repertoire) -> bool {
+    lexicon::is_finite_verb(word)
+        || postures::is_posture_verb(word)
+        || (known.knows_any() && lexicon::is_dataset_verb(word))
+}
+
+/// A verb the lists do not hold, read from its form: a word in "-s" followed by a particle
+/// of direction ("ducks down", "scoots back", "tiptoes away"). Limbs and people in "-s"
+/// ("arms up", "the twins forward") are nouns.
+fn unknown_verb(word: &str, next: Option<&str>) -> bool {
+    const PARTICLES: &[&str] = &[
+        "down",
+        "up",
+        "back",
+        "forward",
+        "forwards",
+        "backward",
+        "backwards",
+        "away",
+        "off",
+        "over",
+        "sideways",
+        "aside",
+        "around",
+        "out",
+        "onto",
+        "into",
+    ];
+    word.len() > 3
+        && word.ends_with('s')
+        && !word.ends_with("ss")
+        && next.is_some_and(|n| PARTICLES.contains(&n))
+        && accounting::limb(word).is_none()
+        && !matches!(word, "shoulders" | "hips" | "eyes" | "heads" | "others")
+        && !lexicon::is_subject_noun(word)
+        && !lexicon::is_subject_word(word)
 }
 
 /// True when the words up to the next comma or "and" only point back at the movement before
@@ -123,6 +165,58 @@ pub(super) fn clauses(text: &str, known: Repertoire) -> Vec<Vec<String>> {
     let mut out = Vec::new();
     for sentence in tokens.split(|t| t == ".") {
         out.extend(sentence_clauses(sentence, known));
+    }
+    with_gaps_filled(out, known)
+}
+
+/// Words that open a clause that says only where the movement before goes next ("walks to
+/// the left, **then to the right**", "jumps forward, then backward").
+const WAYS: &[&str] = &[
+    "to",
+    "toward",
+    "towards",
+    "forward",
+    "forwards",
+    "backward",
+    "backwards",
+    "back",
+    "sideways",
+    "left",
+    "right",
+];
+
+/// Clauses that leave out their verb take the one before's ("turns his head to the left,
+/// then to the right" is "turns his head to the right"): the words of the clause before from
+/// its verb up to where its own way begins go in front.
+fn with_gaps_filled(clauses: Vec<Vec<String>>, known: Repertoire) -> Vec<Vec<String>> {
+    let mut out: Vec<Vec<String>> = Vec::with_capacity(clauses.len());
+    for clause in clauses {
+        // Up to what rides on it ("then to the right **with the left hand on the head**").
+        let own = clause
+            .iter()
+            .take_while(|w| {
+                !matches!(
+                    w.as_str(),
+                    "with" | "holding" | "keeping" | "while" | "and" | ","
+                )
+            })
+            .count();
+        let gapped = clause.first().is_some_and(|w| WAYS.contains(&w.as_str()))
+            && !clause[..own].iter().any(|w| is_verb(w, known));
+        let head = out.last().filter(|_| gapped).and_then(|before| {
+            let verb = before.iter().position(|w| is_verb(w, known))?;
+            let way = (verb + 1..before.len())
+                .find(|&i| WAYS.contains(&before[i].as_str()) || before[i] == ",")
+                .unwrap_or(before.len());
+            Some(before[verb..way].to_vec())
+        });
+        match head {
+            Some(mut head) => {
+                head.extend(clause);
+                out.push(head);
+            }
+            None => out.push(clause),
+        }
     }
     out
 }

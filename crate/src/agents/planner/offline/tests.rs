@@ -899,3 +899,95 @@ fn no_clause_of_any_prompt_set_goes_unread() {
     }
     assert!(unread.is_empty(), "{}", unread.join("\n"));
 }
+
+#[test]
+fn a_clause_without_its_verb_takes_the_verb_before() {
+    let texts = |prompt: &str| -> Vec<String> {
+        clauses(prompt, Repertoire::new(None))
+            .into_iter()
+            .map(|c| c.join(" "))
+            .collect()
+    };
+    assert_eq!(
+        texts("a man turns his head to the left, then to the right"),
+        [
+            "a man turns his head to the left",
+            "turns his head to the right"
+        ]
+    );
+    assert_eq!(
+        texts("he walks to the left with the right hand on the head, then forward with both hands on the head"),
+        [
+            "he walks to the left with the right hand on the head",
+            "walks forward with both hands on the head"
+        ]
+    );
+    // A clause with its own verb keeps it; one with nothing before stays as it is.
+    assert_eq!(
+        texts("she jumps forward, then walks back"),
+        ["she jumps forward", "walks back"]
+    );
+    assert_eq!(texts("to the left"), ["to the left"]);
+    let plan = plan("A person jumps forward, then backward.", None);
+    assert_eq!(plan.segments.len(), 2, "{plan:#?}");
+    assert!(plan.segments[1].text.contains("backward"), "{plan:#?}");
+}
+
+#[test]
+fn a_verb_no_list_holds_is_read_by_its_form() {
+    let texts: Vec<String> = clauses(
+        "he throws a left jab, then a right hook, ducks down, and steps back",
+        Repertoire::new(None),
+    )
+    .into_iter()
+    .map(|c| c.join(" "))
+    .collect();
+    assert!(texts.contains(&"ducks down".to_string()), "{texts:?}");
+    assert!(texts.contains(&"a right hook".to_string()), "{texts:?}");
+    // Limbs in "-s" are no verbs.
+    let texts = clauses("she jumps, arms up", Repertoire::new(None));
+    assert_eq!(texts.len(), 1, "{texts:?}");
+}
+
+#[test]
+fn a_clause_made_as_other_words_is_named_in_a_note() {
+    // A toy similarity: texts are the same movement when they share their verb.
+    let verb = |s: &str| -> Vec<f32> {
+        ["walks", "steps", "runs", "jogs"]
+            .iter()
+            .map(|w| if s.contains(w) { 1.0 } else { 0.0 })
+            .chain(std::iter::once(0.1))
+            .collect()
+    };
+    let steps = plan("A dancer steps to the left.", Some(&verb));
+    assert_eq!(steps.segments[0].base, "a person walks to the left");
+    assert!(
+        steps.notes
+            .iter()
+            .any(|n| n.contains("\"a dancer steps to the left\"") && n.contains(MADE_AS)),
+        "{:?}",
+        steps.notes
+    );
+    let walks = plan("A man walks to the left.", Some(&verb));
+    assert!(
+        !walks.notes.iter().any(|n| n.contains(MADE_AS)),
+        "{:?}",
+        walks.notes
+    );
+}
+
+#[test]
+fn a_posture_keeps_its_limbs_when_another_clause_moves_others() {
+    let plan = plan(
+        "The woman kneels on one knee while waving both hands above her head.",
+        None,
+    );
+    let track = plan.segments[0].postures.as_ref().expect("a kneel");
+    assert!(
+        track
+            .keys
+            .iter()
+            .any(|k| k.script.name.as_deref() == Some("kneel on one knee")),
+        "{plan:#?}"
+    );
+}
