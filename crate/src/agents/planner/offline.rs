@@ -197,6 +197,9 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                         segments.push(next);
                     }
                 }
+                if planned.over_model {
+                    notes.extend(said_otherwise(words, &model_segment(), matcher.as_ref()));
+                }
                 let made = &mut segments[clause_start..];
                 let poses =
                     place_limb_phrases(words, &planned.named, matcher.as_ref(), made, &mut notes);
@@ -324,6 +327,20 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             }
             previous = Some(found.gestures.last().copied().unwrap_or(last));
             ends_standing = Some(last).filter(|a| a.label().is_some() && *a != Action::LieDown);
+        }
+        // What the clause says of a limb that nothing moves or holds is named too.
+        let held_parts: Vec<BodyPart> = held
+            .iter()
+            .filter(|(span, _)| span.start == clause_start)
+            .flat_map(|(_, p)| p.parts.clone())
+            .collect();
+        for (phrase, limb) in
+            accounting::limbs_left_unplaced(words, &segments[clause_start..], &held_parts, &notes)
+        {
+            notes.push(format!(
+                "\"{phrase}\" {NOT_PLACED}: the built-in planner has no rule for this movement \
+                 of the {limb}"
+            ));
         }
         // A safety net under the rules: a clause that neither made a segment nor left a note
         // is named now. The prompt sets' test checks the rules never need it.
@@ -970,7 +987,12 @@ fn segment(words: &[&str], found: &Movements, style: Option<&str>) -> Segment {
 fn said_otherwise(words: &[&str], made: &Segment, matcher: Option<&Matcher>) -> Option<String> {
     let matcher = matcher?;
     let head = accounting::head_phrase(&lexicon::without_subject(words));
-    if head.is_empty() || matcher.same(&head, &made.text).is_some() {
+    // The path is part of what the segment says ("walks forward" along "a circle, clockwise").
+    let said = match &made.trajectory {
+        Some(path) => format!("{} along {}", made.text, path.describe()),
+        None => made.text.clone(),
+    };
+    if head.is_empty() || matcher.same(&head, &said).is_some() {
         return None;
     }
     Some(format!(

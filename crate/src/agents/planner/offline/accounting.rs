@@ -13,6 +13,8 @@
 //!   all ("spins with **his right arm upwards**"): named in a note.
 
 use super::super::lexicon;
+use crate::plan::Segment;
+use crate::skeleton::{BodyPart, Side};
 
 /// Words that end a phrase inside a clause.
 const BOUNDARIES: &[&str] = &[",", "and", "while", "whilst", "then", "as", "but"];
@@ -136,6 +138,80 @@ pub(super) fn limb_phrases_without_movement(
     out
 }
 
+/// The phrases of a clause about a limb that nothing in the plan moves or holds, for a note:
+/// a limb of a side the clause names ("tapping **his right foot**") with no part
+/// instruction, held posture or held pose (`held`) on it over the clause's segments (`made`),
+/// and no note quoting the phrase yet. A base motion moves the limbs its own way ("kicks
+/// with the right leg"), so it accounts for them, except standing (no limb) and a walk or a
+/// run (the legs only: "walking, taps his head **with his left hand**").
+pub(super) fn limbs_left_unplaced(
+    words: &[&str],
+    made: &[Segment],
+    held: &[BodyPart],
+    notes: &[String],
+) -> Vec<(String, &'static str)> {
+    if made.is_empty() {
+        return Vec::new();
+    }
+    // A base motion moves the limbs its own way, except standing (none) and walking or
+    // running (only the legs: arms swing whatever the clause asked of them).
+    let base_moves = |s: &Segment, part: BodyPart| {
+        let arm = matches!(part, BodyPart::LeftArm | BodyPart::RightArm);
+        let gait = ["walks", "runs", "jogs"]
+            .iter()
+            .any(|g| s.base.split(' ').any(|w| w == *g));
+        !s.base.ends_with("stands still") && !(arm && gait)
+    };
+    let covered = |part: BodyPart| {
+        held.contains(&part)
+            || made.iter().all(|s| {
+                base_moves(s, part)
+                    || s.parts.get(part).is_some()
+                    || s.postures.as_ref().is_some_and(|t| t.parts.contains(&part))
+            })
+    };
+    let mut out = Vec::new();
+    for (i, w) in words.iter().enumerate() {
+        let Some(limb) = limb(w) else { continue };
+        let side = words[i.saturating_sub(2)..i]
+            .iter()
+            .rev()
+            .find_map(|w| Side::of_word(w));
+        let parts: Vec<BodyPart> = match (limb, side) {
+            ("arm", Some(Side::Left)) => vec![BodyPart::LeftArm],
+            ("arm", Some(Side::Right)) => vec![BodyPart::RightArm],
+            ("leg", Some(Side::Left)) => vec![BodyPart::LeftLeg],
+            ("leg", Some(Side::Right)) => vec![BodyPart::RightLeg],
+            _ => continue,
+        };
+        if parts.iter().all(|p| covered(*p)) {
+            continue;
+        }
+        // From a boundary, or from the opener or participle that begins the phrase
+        // ("…, **tapping** his right foot": the comma before a rider is gone by now).
+        let start = (0..i)
+            .rev()
+            .find_map(|k| {
+                if BOUNDARIES.contains(&words[k]) {
+                    Some(k + 1)
+                } else if OPENERS.contains(&words[k]) || words[k].ends_with("ing") {
+                    Some(k)
+                } else {
+                    None
+                }
+            })
+            .unwrap_or(0);
+        let end = (i + 1..words.len())
+            .find(|&k| BOUNDARIES.contains(&words[k]) || OPENERS.contains(&words[k]))
+            .unwrap_or(words.len());
+        let phrase = words[start..end].join(" ");
+        if !notes.iter().any(|n| n.contains(&phrase)) && !out.iter().any(|(p, _)| *p == phrase) {
+            out.push((phrase, limb));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,6 +242,30 @@ mod tests {
             limb_phrases_without_movement(&w, &[2]),
             [("arms flapping like wings".to_string(), "arm")]
         );
+    }
+
+    #[test]
+    fn a_limb_nothing_moves_on_a_standing_segment_is_found() {
+        let stand = Segment {
+            text: "a person stands still".into(),
+            seconds: 2.0,
+            base: "a person stands still".into(),
+            parts: Default::default(),
+            trajectory: None,
+            postures: None,
+        };
+        let w = words("a man stands still with his arms folded tapping his right foot");
+        let found = limbs_left_unplaced(&w, std::slice::from_ref(&stand), &[], &[]);
+        assert_eq!(found, [("tapping his right foot".to_string(), "leg")]);
+        // Held, or named in a note already, or on a segment that moves: accounted for.
+        assert!(limbs_left_unplaced(&w, &[stand.clone()], &[BodyPart::RightLeg], &[]).is_empty());
+        let noted = ["\"tapping his right foot\" was left out".to_string()];
+        assert!(limbs_left_unplaced(&w, &[stand.clone()], &[], &noted).is_empty());
+        let kick = Segment {
+            base: "a person kicks with the right leg".into(),
+            ..stand
+        };
+        assert!(limbs_left_unplaced(&w, &[kick], &[], &[]).is_empty());
     }
 
     #[test]

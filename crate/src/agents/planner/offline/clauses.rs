@@ -90,7 +90,7 @@ fn is_verb(word: &str, known: Repertoire) -> bool {
 }
 
 /// A verb the lists do not hold, read from its form: a word in "-s" followed by a particle
-/// of direction ("ducks down", "scoots back", "tiptoes away"). Limbs and people in "-s"
+/// of direction ("ducks down", "scoots back", "drops to one knee"). Limbs and people in "-s"
 /// ("arms up", "the twins forward") are nouns.
 fn unknown_verb(word: &str, next: Option<&str>) -> bool {
     const PARTICLES: &[&str] = &[
@@ -110,6 +110,7 @@ fn unknown_verb(word: &str, next: Option<&str>) -> bool {
         "out",
         "onto",
         "into",
+        "to",
     ];
     word.len() > 3
         && word.ends_with('s')
@@ -149,6 +150,7 @@ fn action_or_other(word: &str, next: &[&str]) -> bool {
                     | "round"
                     | "back"
                     | "to"
+                    | "in"
                     | "toward"
                     | "towards"
                     | "sideways"

@@ -226,7 +226,7 @@ fn is_limb_determiner(word: &str) -> bool {
 /// Words after which a body point is what a hand touches, not what moves.
 const ONTO: &[&str] = &[
     "on", "onto", "to", "at", "against", "over", "touching", "touches", "touch", "near",
-    "covering", "covers", "behind",
+    "covering", "covers", "behind", "in",
 ];
 
 /// Whether any of `words` is in the phrase.

@@ -962,7 +962,8 @@ fn a_clause_made_as_other_words_is_named_in_a_note() {
     let steps = plan("A dancer steps to the left.", Some(&verb));
     assert_eq!(steps.segments[0].base, "a person walks to the left");
     assert!(
-        steps.notes
+        steps
+            .notes
             .iter()
             .any(|n| n.contains("\"a dancer steps to the left\"") && n.contains(MADE_AS)),
         "{:?}",
