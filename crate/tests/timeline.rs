@@ -1,9 +1,11 @@
 //! The plan as a timeline (issue 38): a clip on a body-part track changes its parts over its
 //! span only, and moving a clip regenerates only the spans it left and entered.
 
+use coma::agents::pipeline::{clip_frames, clip_steps};
 use coma::agents::planner::offline;
 use coma::executor::block_on;
 use coma::model::edit::SEAM_STEPS;
+use coma::model::motion_model::steps_of;
 use coma::plan::{Clip, Plan};
 use coma::session::{Command, Llm, Motion, Outcome, Session};
 use coma::skeleton::{BodyPart, Pose};
@@ -85,9 +87,32 @@ fn joints(motion: &Motion) -> Vec<Pose> {
         .collect()
 }
 
-fn steps_of(frames: Range<usize>) -> Range<usize> {
-    frames.start / FRAMES_PER_TOKEN..frames.end.div_ceil(FRAMES_PER_TOKEN)
+/// The largest difference (metres) of any joint of frame `f` between two motions, relative to
+/// the pelvis and in world space.
+fn moved_at(a: &[Pose], b: &[Pose], f: usize) -> (f64, f64) {
+    let mut out = (0.0f64, 0.0f64);
+    for (ja, jb) in a[f].iter().zip(&b[f]) {
+        for i in 0..3 {
+            let local = (ja[i] - a[f][0][i]) - (jb[i] - b[f][0][i]);
+            out.0 = out.0.max(local.abs());
+            out.1 = out.1.max((ja[i] - jb[i]).abs());
+        }
+    }
+    out
 }
+
+/// The largest differences (metres, relative to the pelvis and in world space) of the frames
+/// `frames` between two motions.
+fn moved(a: &[Pose], b: &[Pose], frames: Range<usize>) -> (f64, f64) {
+    frames
+        .map(|f| moved_at(a, b, f))
+        .fold((0.0, 0.0), |m, d| (m.0.max(d.0), m.1.max(d.1)))
+}
+
+/// Joints outside the affected steps must not move at all: the base motion is decoded there
+/// and nothing after the decoder reads across time into them. 0.1 mm leaves room for f32
+/// rounding only.
+const UNCHANGED_M: f64 = 1e-4;
 
 #[test]
 fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_and_entered() {
@@ -97,14 +122,34 @@ fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_a
     let without = run(&session, &bare);
     let with = run(&session, &waving);
     // The clip spans the join of the walk and the run; the rest of the run is the same.
-    let span = coma::agents::pipeline::clip_frames(&waving, &waving.clips[0], &with.tokens);
+    let span = clip_frames(&waving, &waving.clips[0], &with.tokens);
     let steps = steps_of(span.clone());
     let reach = steps.start - SEAM_STEPS..steps.end + SEAM_STEPS;
+    assert_eq!(clip_steps(&waving, &waving.clips[0], &with.tokens), reach);
     let changed = changed_steps(&without, &with);
     assert!(!changed.is_empty());
     for (p, s) in &changed {
         assert_eq!(*p, 0, "part {p} changed at step {s}");
         assert!(reach.contains(s), "step {s} outside {reach:?}");
+    }
+    // The clip is a layer over the walk and run without it: their tokens are its base, and
+    // outside its reach the motion is theirs.
+    assert_eq!(with.tokens.base(), without.tokens);
+    let (a, b) = (joints(&without), joints(&with));
+    let (before, after) = (
+        moved(&a, &b, 0..reach.start * FRAMES_PER_TOKEN),
+        moved(&a, &b, reach.end * FRAMES_PER_TOKEN..a.len()),
+    );
+    eprintln!(
+        "laying the clip, joints outside its steps {reach:?} move by up to {:.4} mm before and \
+         {:.4} mm after (relative to the pelvis), {:.4} mm and {:.4} mm in world space",
+        before.0 * 1e3,
+        after.0 * 1e3,
+        before.1 * 1e3,
+        after.1 * 1e3
+    );
+    for d in [before.0, before.1, after.0, after.1] {
+        assert!(d < UNCHANGED_M, "{d} m");
     }
 
     // Moved later: only the steps of the old and the new span (and their seams) change.
@@ -112,7 +157,7 @@ fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_a
     moved_plan.clips[0].start = 6.0;
     moved_plan.clips[0].end = 8.5;
     let moved_plan = moved_plan.checked().unwrap();
-    let moved = execute(
+    let moved_clip = execute(
         &session,
         Command::EditClips {
             tokens: with.tokens.clone(),
@@ -121,42 +166,73 @@ fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_a
             seed: 11,
         },
     );
-    let new_span =
-        coma::agents::pipeline::clip_frames(&moved_plan, &moved_plan.clips[0], &moved.tokens);
+    let new_span = clip_frames(&moved_plan, &moved_plan.clips[0], &moved_clip.tokens);
     let new_steps = steps_of(new_span);
     let both =
         steps.start.min(new_steps.start) - SEAM_STEPS..steps.end.max(new_steps.end) + SEAM_STEPS;
-    let changed = changed_steps(&with, &moved);
+    let changed = changed_steps(&with, &moved_clip);
     assert!(!changed.is_empty());
     for (p, s) in &changed {
         assert_eq!(*p, 0, "part {p} changed at step {s}");
         assert!(both.contains(s), "step {s} outside {both:?}");
     }
-    // What the token change does to the joints: the decoder is shared by the parts and reads
-    // the whole sequence, and the root's turn is integrated, so frames outside the affected
-    // steps move too. Printed, not asserted: issue 38's "joints outside the span unchanged"
-    // does not hold yet (see the issue's notes).
-    let (a, b) = (joints(&with), joints(&moved));
-    let local = |f: usize| {
-        a[f].iter()
-            .zip(b[f].iter())
-            .map(|(ja, jb)| {
-                (0..3)
-                    .map(|i| ((ja[i] - a[f][0][i]) - (jb[i] - b[f][0][i])).abs())
-                    .fold(0.0, f64::max)
-            })
-            .fold(0.0, f64::max)
-    };
-    let before = (0..both.start * FRAMES_PER_TOKEN)
-        .map(local)
-        .fold(0.0, f64::max);
-    let after = (both.end * FRAMES_PER_TOKEN..a.len())
-        .map(local)
-        .fold(0.0, f64::max);
-    eprintln!(
-        "joints relative to the pelvis outside the affected steps {both:?}: up to {:.1} mm \
-         before, {:.1} mm after",
-        before * 1e3,
-        after * 1e3
+    // The base under the clip is the same motion wherever the clip lies.
+    assert_eq!(moved_clip.tokens.base(), with.tokens.base());
+    // What the token change does to the joints outside the affected steps: nothing. The
+    // decoder is shared by the parts and reads the whole sequence, and the root's turn is
+    // integrated, but the base is decoded there and the clip's parts are taken from the final
+    // tokens over the clip's steps only.
+    let (a, b) = (joints(&with), joints(&moved_clip));
+    let (before, after) = (
+        moved(&a, &b, 0..both.start * FRAMES_PER_TOKEN),
+        moved(&a, &b, both.end * FRAMES_PER_TOKEN..a.len()),
     );
+    eprintln!(
+        "joints relative to the pelvis outside the affected steps {both:?}: up to {:.4} mm \
+         before, {:.4} mm after; in world space {:.4} mm before, {:.4} mm after",
+        before.0 * 1e3,
+        after.0 * 1e3,
+        before.1 * 1e3,
+        after.1 * 1e3
+    );
+    for d in [before.0, before.1, after.0, after.1] {
+        assert!(d < UNCHANGED_M, "{d} m");
+    }
+    // Inside, the waving arm moved with its clip.
+    let (_, inside) = moved(
+        &a,
+        &b,
+        both.start * FRAMES_PER_TOKEN..both.end * FRAMES_PER_TOKEN,
+    );
+    assert!(inside > 0.01, "{inside} m");
+
+    // Deleted: the base motion again, exactly.
+    let deleted = execute(
+        &session,
+        Command::EditClips {
+            tokens: with.tokens.clone(),
+            before: waving.clone(),
+            plan: bare.clone(),
+            seed: 12,
+        },
+    );
+    assert_eq!(deleted.tokens, without.tokens);
+    assert!(deleted.tokens.base_patches().is_empty());
+    let (all_local, all_world) = moved(&joints(&without), &joints(&deleted), 0..a.len());
+    eprintln!(
+        "deleting the clip: joints differ from the motion without it by {:.4} mm (relative to \
+         the pelvis), {:.4} mm in world space",
+        all_local * 1e3,
+        all_world * 1e3
+    );
+    assert!(all_local < UNCHANGED_M && all_world < UNCHANGED_M);
+    // And the deletion undoes: the clip laid again at its place is the motion with it.
+    let again = execute(
+        &session,
+        Command::Decode {
+            tokens: with.tokens.clone(),
+            plan: Some(waving.clone()),
+        },
+    );
+    assert_eq!(again.joints, with.joints);
 }

@@ -9,9 +9,9 @@
 use crate::agents::llm::{LlmClient, Transport};
 use crate::agents::reviewer::{self, Review, Scorer};
 use crate::features::{features_to_joints, FeatureFrame, Features};
-use crate::model::edit::PartText;
+use crate::model::edit::{part_indices, PartText, SEAM_STEPS};
 use crate::model::generate::MotionTokens;
-use crate::model::motion_model::sampling;
+use crate::model::motion_model::{sampling, steps_of};
 use crate::model::MotionModel;
 use crate::plan::{Clip, Plan, Segment};
 use crate::share::{Edit, EditKind};
@@ -105,7 +105,8 @@ pub struct Run {
     /// Every step, as a share link records it.
     #[serde(skip)]
     pub history: Vec<Edit>,
-    /// The blended motion's tokens `[part][layer][step]`.
+    /// The motion's final tokens `[part][layer][step]`, with the base (whole-body) motion's
+    /// codes under each body-part clip as a layer.
     #[serde(skip)]
     pub tokens: MotionTokens,
     /// Notes of the reviewer (a judge that failed, a review skipped).
@@ -360,8 +361,11 @@ async fn blend(
 }
 
 /// The plan's clips that generate motion (not key poses) laid on the blended motion in start
-/// order, each on its parts over its span (see [`MotionModel::edit_parts_span`]). Clip
-/// `index` samples with its own seed, so a link's history names it.
+/// order, each on its parts over its span (see [`MotionModel::edit_parts_span`]) as a layer:
+/// the blended tokens are the base motion, and the tokens returned keep its codes under every
+/// clip ([`MotionTokens::base_patches`]), so the engine shows the base outside the clips'
+/// spans exactly and a clip can be moved or taken off without touching the rest. Clip `index`
+/// samples with its own seed, so a link's history names it.
 pub async fn lay_clips(
     model: &MotionModel,
     plan: &Plan,
@@ -384,11 +388,16 @@ pub async fn lay_clips(
 }
 
 /// The motion of `tokens`, made under `before`, changed to follow `after`'s clips: a clip
-/// `after` no longer has (deleted, or moved) gives its parts back to the segment under it over
-/// its old span; a clip `after` has anew (added, moved, reworded) is generated over its span.
-/// The tokens outside those spans (and [`crate::model::edit::SEAM_STEPS`] steps around them)
-/// stay as they were. Only the clips may differ: a changed whole-body track is a new run.
-/// Returns the tokens and the edits, as a link's history records them.
+/// `after` no longer has (deleted, or moved) gives its parts back to the base motion over its
+/// old span, exactly, from the base codes its layer kept (see [`MotionTokens::base_patches`]);
+/// a clip `after` has anew (added, moved, reworded) is laid over its span on the base, as a
+/// layer. The tokens outside those spans (and [`crate::model::edit::SEAM_STEPS`] steps around
+/// them) stay as they were, and so does the motion there. A clip without a layer to take off
+/// (a segment's own part instruction lifted onto the tracks, or tokens from before clips were
+/// layers) has its span regenerated from the segment under it instead. Only the clips may
+/// differ: a changed whole-body track is a new run. Returns the tokens and the edits, as a
+/// link's history records them (a clip's layer taken off is an edit of its parts and frames
+/// with no text and seed 0: nothing was sampled).
 pub async fn edit_clips(
     model: &MotionModel,
     before: &Plan,
@@ -404,6 +413,20 @@ pub async fn edit_clips(
     }
     let generated = |c: &&Clip| c.postures.is_none();
     let mut edits = Vec::new();
+    // The steps each clip that stays keeps under its layer, per part: taking a clip off must
+    // not take them.
+    let kept: Vec<(usize, std::ops::Range<usize>)> = after
+        .clips
+        .iter()
+        .filter(generated)
+        .filter(|c| before.clips.contains(c))
+        .flat_map(|c| {
+            let steps = clip_steps(before, c, &tokens);
+            part_indices(&c.parts)
+                .into_iter()
+                .map(move |p| (p, steps.clone()))
+        })
+        .collect();
     let gone = before
         .clips
         .iter()
@@ -411,9 +434,30 @@ pub async fn edit_clips(
         .filter(|c| !after.clips.contains(c));
     for (k, clip) in gone.enumerate() {
         let frames = clip_frames(before, clip, &tokens);
+        let steps = clip_steps(before, clip, &tokens);
+        let free: Vec<(usize, std::ops::Range<usize>)> = part_indices(&clip.parts)
+            .into_iter()
+            .flat_map(|p| {
+                let others: Vec<std::ops::Range<usize>> = kept
+                    .iter()
+                    .filter(|(q, _)| *q == p)
+                    .map(|(_, r)| r.clone())
+                    .collect();
+                subtract(steps.clone(), &others)
+                    .into_iter()
+                    .map(move |r| (p, r))
+            })
+            .collect();
+        if free.iter().all(|(p, r)| tokens.covers(&[*p], r.clone())) {
+            for (p, r) in &free {
+                tokens = tokens.without_layer(&[*p], r.clone());
+            }
+            edits.push(clip_edit("", &clip.parts, frames, 0));
+            continue;
+        }
         let segment = &before.segments[before.segment_at(clip.middle())];
         let seed = seed_of(seed, CLIP_SEED_BASE + k, 1);
-        tokens = model
+        let regenerated = model
             .regenerate_parts_span(
                 &tokens,
                 &clip.parts,
@@ -423,6 +467,7 @@ pub async fn edit_clips(
                 seed,
             )
             .await;
+        tokens = regenerated.keeping_layers_of(&tokens);
         edits.push(clip_edit(&segment.base, &clip.parts, frames, seed));
     }
     let new = after
@@ -445,8 +490,30 @@ pub async fn edit_clips(
     Ok((tokens, edits))
 }
 
+/// The steps of `range` that none of `others` covers, as runs.
+fn subtract(
+    range: std::ops::Range<usize>,
+    others: &[std::ops::Range<usize>],
+) -> Vec<std::ops::Range<usize>> {
+    let mut runs = Vec::new();
+    let mut start = range.start;
+    for s in range.clone() {
+        if others.iter().any(|o| o.contains(&s)) {
+            if start < s {
+                runs.push(start..s);
+            }
+            start = s + 1;
+        }
+    }
+    if start < range.end {
+        runs.push(start..range.end);
+    }
+    runs
+}
+
 /// One clip that generates motion laid on `tokens` over its span, the rest of the body
-/// conditioned on the base motion of the segment under the clip's middle; with the edit a
+/// conditioned on the base motion of the segment under the clip's middle, and kept as a
+/// layer: the base codes of its parts over [`clip_steps`] go with the tokens. With the edit a
 /// link's history records.
 async fn lay_clip(
     model: &MotionModel,
@@ -460,6 +527,11 @@ async fn lay_clip(
     let laid = model
         .edit_parts_span(tokens, &clip.text, &clip.parts, rest, frames.clone(), seed)
         .await;
+    let laid = tokens.layered(
+        laid,
+        &part_indices(&clip.parts),
+        clip_steps(plan, clip, tokens),
+    );
     (laid, clip_edit(&clip.text, &clip.parts, frames, seed))
 }
 
@@ -491,6 +563,14 @@ pub fn clip_frames(plan: &Plan, clip: &Clip, tokens: &MotionTokens) -> std::ops:
     };
     let (from, to) = (at(clip.start), at(clip.end));
     from..to.max(from)
+}
+
+/// Token steps (of 4 frames) a clip's layer covers: the steps of its frames
+/// ([`clip_frames`]) and [`crate::model::edit::SEAM_STEPS`] more either side, where laying it
+/// regenerates the seams, within the motion.
+pub fn clip_steps(plan: &Plan, clip: &Clip, tokens: &MotionTokens) -> std::ops::Range<usize> {
+    let steps = steps_of(clip_frames(plan, clip, tokens));
+    steps.start.saturating_sub(SEAM_STEPS)..(steps.end + SEAM_STEPS).min(tokens.steps())
 }
 
 /// Feature rows whose root travel is a path laid on purpose (segments with a trajectory):
@@ -567,13 +647,38 @@ pub fn lay_postures(
 }
 
 /// The features (not normalised, 20 fps) of a run's tokens with every segment's path laid on
-/// the root. A link rebuilds the motion with this and its plan alone.
+/// the root; body-part clips laid as layers are composed over the base motion (see
+/// [`MotionModel::features`]). A link rebuilds the motion with this and its plan alone.
 pub async fn motion_features(
     model: &MotionModel,
     plan: &Plan,
     tokens: &MotionTokens,
 ) -> (Features, Vec<String>) {
-    let mut features = model.features(tokens).await;
+    let (features, _, notes) = motion_features_and_base(model, plan, tokens).await;
+    (features, notes)
+}
+
+/// [`motion_features`], and the base motion's features alone with the same paths where clips
+/// lie on the tokens as layers (`None` without). The paths are laid from the root's columns,
+/// which the base and the composed motion share, so both walk them the same way.
+pub async fn motion_features_and_base(
+    model: &MotionModel,
+    plan: &Plan,
+    tokens: &MotionTokens,
+) -> (Features, Option<Features>, Vec<String>) {
+    let (features, base) = model.features_and_base(tokens).await;
+    let (features, notes) = lay_paths(plan, tokens, features);
+    let base = base.map(|base| lay_paths(plan, tokens, base).0);
+    (features, base, notes)
+}
+
+/// `features` with every segment's path laid on the root, and notes for the paths that could
+/// not be.
+fn lay_paths(
+    plan: &Plan,
+    tokens: &MotionTokens,
+    mut features: Features,
+) -> (Features, Vec<String>) {
     let mut notes = Vec::new();
     for (segment, range) in plan.segments.iter().zip(segment_ranges(plan, tokens)) {
         if let Some(path) = &segment.trajectory {

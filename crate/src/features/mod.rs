@@ -19,6 +19,7 @@ use crate::skeleton::{self, joint, Offsets, Pose, NUM_JOINTS};
 use std::ops::Range;
 
 pub mod check;
+pub mod layers;
 
 /// Floats per frame.
 pub const FEATURE_DIM: usize = 263;
@@ -255,12 +256,28 @@ pub fn features_to_joints_with_final(features: &[FeatureFrame]) -> Vec<Pose> {
 /// to the new last pose's successor). The 6D rotations and the foot contacts are kept: they
 /// depend only on bone directions and on motion that the new lengths do not change.
 pub fn with_reference_bones(features: &[FeatureFrame]) -> Features {
+    with_reference_bones_fitted(features, &reference_fit(features))
+}
+
+/// What [`with_reference_bones`] keeps of a motion as a whole (its floor and the mean shape
+/// of the pelvis's and the upper spine's triangles of bones): fitted on the frames shown, not
+/// on the extra pose the last velocities lead to, so the shown joints are exactly
+/// `fixed_bones` of the joints shown before.
+pub fn reference_fit(features: &[FeatureFrame]) -> skeleton::SkeletonFit {
+    skeleton::SkeletonFit::of(&features_to_joints(features))
+}
+
+/// [`with_reference_bones`] with a fit of one's own. The fit is of the whole motion, and
+/// everything else is frame by frame: a motion with body-part clips laid as layers takes its
+/// base motion's fit, so that a clip (its collars move the upper spine's triangle, its feet
+/// the floor) changes no frame outside its span.
+pub fn with_reference_bones_fitted(
+    features: &[FeatureFrame],
+    fit: &skeleton::SkeletonFit,
+) -> Features {
     if features.is_empty() {
         return Vec::new();
     }
-    // Fitted on the frames shown, not on the extra pose the last velocities lead to, so the
-    // shown joints are exactly `fixed_bones` of the joints shown before.
-    let fit = skeleton::SkeletonFit::of(&features_to_joints(features));
     let poses = fit.apply(&features_to_joints_with_final(features));
     let (rots, _) = recover_root(features);
     features

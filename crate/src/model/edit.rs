@@ -40,7 +40,7 @@ pub const SEAM_STEPS: usize = 2;
 const WINDOW_CONTEXT_STEPS: usize = 6;
 
 /// The model indices of `parts`, in model order.
-fn part_indices(parts: &[BodyPart]) -> Vec<usize> {
+pub fn part_indices(parts: &[BodyPart]) -> Vec<usize> {
     (0..PARTS)
         .filter(|p| parts.contains(&BodyPart::ALL[*p]))
         .collect()

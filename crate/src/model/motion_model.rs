@@ -5,7 +5,7 @@
 use super::edit::{part_text, PartText};
 use super::generate::{MotionTokens, SamplingOptions};
 use super::{Spam, SpamFiles, SpamLoadError};
-use crate::features::{features_to_joints, Features, Normalizer};
+use crate::features::{features_to_joints, layers, Features, Normalizer};
 use crate::skeleton::{BodyPart, Pose};
 use crate::text::minilm::{MiniLmError, SentenceEncoder};
 use crate::timing::{FRAMES_PER_TOKEN, MAX_FRAMES};
@@ -243,9 +243,26 @@ impl MotionModel {
             .await
     }
 
-    /// The features (not normalised) of tokens.
+    /// The features (not normalised, 20 fps) of tokens: their decoding, or, where body-part
+    /// clips lie on them as layers, the base motion with the clips' parts laid over their
+    /// spans (see [`crate::features::layers`]).
     pub async fn features(&self, tokens: &MotionTokens) -> Features {
-        self.normalizer.denormalize(&self.spam.decode(tokens).await)
+        self.features_and_base(tokens).await.0
+    }
+
+    /// [`MotionModel::features`], and the base motion's features alone where clips lie on the
+    /// tokens as layers (`None` without: the motion is its base). Decoding the base costs a
+    /// second pass of the decoder, only for motions with such clips.
+    pub async fn features_and_base(&self, tokens: &MotionTokens) -> (Features, Option<Features>) {
+        let decoded = self.normalizer.denormalize(&self.spam.decode(tokens).await);
+        if tokens.base_patches().is_empty() {
+            return (decoded, None);
+        }
+        let base = self
+            .normalizer
+            .denormalize(&self.spam.decode(&tokens.base()).await);
+        let composed = layers::compose(&base, &decoded, &layers::layer_weights(tokens));
+        (composed, Some(base))
     }
 
     /// Joint positions of tokens (metres, 20 fps).
@@ -262,8 +279,8 @@ fn each(parts: &[BodyPart], instruction: &str) -> Vec<(BodyPart, String)> {
         .collect()
 }
 
-/// The token steps that cover `frames` (20 fps).
-fn steps_of(frames: std::ops::Range<usize>) -> std::ops::Range<usize> {
+/// The token steps (of 4 frames) that cover `frames` (20 fps).
+pub fn steps_of(frames: std::ops::Range<usize>) -> std::ops::Range<usize> {
     frames.start / FRAMES_PER_TOKEN..frames.end.div_ceil(FRAMES_PER_TOKEN)
 }
 

@@ -47,7 +47,9 @@ pub enum Command {
         guidance: Option<f32>,
     },
     /// Frames `from..to` (20 fps) of every part regenerated from `text`. `plan` lays its
-    /// segments' paths on the result, as on every command that carries tokens.
+    /// segments' paths on the result, as on every command that carries tokens. Body-part
+    /// clips laid as layers on `tokens` stay layers outside the range; inside it, what the
+    /// text made is the base.
     InBetween {
         tokens: MotionTokens,
         text: String,
@@ -57,7 +59,8 @@ pub enum Command {
         #[serde(default)]
         plan: Option<Plan>,
     },
-    /// The named parts regenerated from `text`; the others keep doing what they do.
+    /// The named parts regenerated from `text`; the others keep doing what they do, and so do
+    /// the clips laid as layers on them. The named parts' clips become part of the base.
     EditParts {
         tokens: MotionTokens,
         text: String,
@@ -68,7 +71,9 @@ pub enum Command {
     },
     /// The motion of `tokens`, made under `before`, changed to follow `plan`, which differs
     /// from it in its body-part clips only (one moved, added, reworded or deleted): only the
-    /// spans of the clips that changed are regenerated.
+    /// spans of the clips that changed are regenerated. Clips are layers over the base
+    /// (whole-body) motion: a clip taken off gives back the base exactly, and the frames
+    /// outside the changed spans stay as they were.
     EditClips {
         tokens: MotionTokens,
         before: Plan,
@@ -86,6 +91,8 @@ pub enum Command {
 /// A motion as the engine hands it out: its tokens, and what they decode to at 20 fps.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Motion {
+    /// The final tokens, with the base motion's codes under the body-part clips laid as
+    /// layers ([`MotionTokens::base_patches`]): the next command takes them as they are.
     pub tokens: MotionTokens,
     /// Joint positions per frame: 22 joints, metres, Y up, starting at the origin facing +Z,
     /// every bone of the reference skeleton's length (see [`crate::skeleton::fixed_bones`]).

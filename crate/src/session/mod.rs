@@ -25,7 +25,10 @@ use crate::agents::llm::Transport;
 use crate::agents::pipeline::{self, RunOptions};
 use crate::agents::reviewer::Scorer;
 use crate::dataset::Vocabulary;
-use crate::features::{features_to_joints, with_reference_bones, FeatureFrame, Features};
+use crate::features::{
+    features_to_joints, reference_fit, with_reference_bones, with_reference_bones_fitted,
+    FeatureFrame, Features,
+};
 use crate::feet::plant_feet;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
 use crate::model::motion_model::sampling;
@@ -190,11 +193,14 @@ impl Session {
                     )
                     .into());
                 }
-                let tokens = self
+                // Every part through all layers over the range: clips there are overwritten,
+                // the ones elsewhere stay layers.
+                let edited = self
                     .model
                     .inbetween(&tokens, &text, from, to.min(frames), seed)
-                    .await;
-                self.motion_outcome(tokens, plan.as_ref()).await
+                    .await
+                    .keeping_layers_of(&tokens);
+                self.motion_outcome(edited, plan.as_ref()).await
             }
             Command::EditParts {
                 tokens,
@@ -207,8 +213,11 @@ impl Session {
                 if parts.is_empty() {
                     return Err("choose at least one body part to edit".into());
                 }
-                let tokens = self.edit_parts(&tokens, &text, &parts, seed).await;
-                self.motion_outcome(tokens, plan.as_ref()).await
+                let edited = self
+                    .edit_parts(&tokens, &text, &parts, seed)
+                    .await
+                    .keeping_layers_of(&tokens);
+                self.motion_outcome(edited, plan.as_ref()).await
             }
             Command::EditClips {
                 tokens,
@@ -323,12 +332,22 @@ impl Session {
     /// stretch; fixed once in the features, the joints shown, the BVH, the JSON and both NPY
     /// exports all describe the same motion on the same bones. Here too its feet are planted
     /// ([`plant_feet`]), whatever made it.
+    ///
+    /// Body-part clips laid as layers on the tokens are composed over the base motion
+    /// ([`crate::features::layers`]), and the one skeleton is fitted on the base motion: what
+    /// follows is frame by frame (the paths read only the root, which is the base's), so the
+    /// frames outside the clips' spans are the base motion's exactly. Only planting the feet
+    /// reads the legs across time (a leg's clip changes where the body is carried after it).
     async fn motion(&self, tokens: MotionTokens, plan: Option<&Plan>) -> (Motion, Vec<String>) {
-        let (features, notes) = match plan {
-            Some(plan) => pipeline::motion_features(&self.model, plan, &tokens).await,
-            None => (self.model.features(&tokens).await, Vec::new()),
+        let (features, base, notes) = match plan {
+            Some(plan) => pipeline::motion_features_and_base(&self.model, plan, &tokens).await,
+            None => {
+                let (features, base) = self.model.features_and_base(&tokens).await;
+                (features, base, Vec::new())
+            }
         };
-        let features = with_reference_bones(&features);
+        let fit = reference_fit(base.as_deref().unwrap_or(&features));
+        let features = with_reference_bones_fitted(&features, &fit);
         let (features, notes) = match plan {
             Some(plan)
                 if plan.segments.iter().any(|s| s.postures.is_some())

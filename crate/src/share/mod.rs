@@ -1,7 +1,7 @@
 //! Share links: a motion, its prompt, plan and edit history packed into the URL fragment, so
 //! that opening the link rebuilds the same motion with no server and no language model.
 //!
-//! A link's fragment is `m=` + base64url(deflate(payload)), no padding. The payload, version 2:
+//! A link's fragment is `m=` + base64url(deflate(payload)), no padding. The payload, version 3:
 //!
 //! ```text
 //!  "CM" 0x02                      magic and version
@@ -15,16 +15,24 @@
 //!  tokens                         parts u8, layers u8, steps varint,
 //!                                   then parts × layers × steps codes of 9 bits, packed
 //!                                   little-endian, part-major, then layer, then step
+//!  base patches                   varint count (at most 4 × steps), then per patch: body
+//!                                   part u8, first step varint, steps varint (≥ 1, ending
+//!                                   within the motion), then layers × steps codes of 9 bits
+//!                                   packed as the tokens' are (layer-major, from a fresh
+//!                                   byte); patches of one part never overlap
 //! ```
 //!
-//! Version 1 is the same without the record; links in it still open.
+//! The base patches are the base (whole-body) motion's codes under the body-part clips, which
+//! lie on it as layers (see [`crate::model::tokens`]): the tokens above are the final ones.
+//! Version 2 is the same without the base patches (a motion with no clip layers), and version
+//! 1 is version 2 without the record; links in both still open.
 //!
 //! Decoding never panics on any input and caps every size before it allocates, so a hostile
 //! link costs at most a few hundred kilobytes and a clear error.
 
 pub mod record;
 
-use crate::model::tokens::{MotionTokens, MAX_LAYERS, MAX_STEPS};
+use crate::model::tokens::{BasePatch, MotionTokens, MAX_LAYERS, MAX_STEPS};
 use base64::Engine;
 pub use record::{LinkPlan, LinkSegment, RunRecord, SegmentScores};
 use serde::{Deserialize, Serialize};
@@ -33,9 +41,11 @@ use serde::{Deserialize, Serialize};
 const BASE64: base64::engine::GeneralPurpose = base64::engine::general_purpose::URL_SAFE_NO_PAD;
 
 /// The payload version this code writes.
-pub const VERSION: u8 = 2;
+pub const VERSION: u8 = 3;
 /// The first version, without the run record.
 const VERSION_1: u8 = 1;
+/// The second version, without the base patches.
+const VERSION_2: u8 = 2;
 const MAGIC: &[u8; 2] = b"CM";
 /// Longest fragment accepted, characters.
 pub const MAX_LINK_CHARS: usize = 96 * 1024;
@@ -108,7 +118,8 @@ pub struct SharedMotion {
     /// segment, its notes), when a run made it.
     pub record: Option<RunRecord>,
     pub history: Vec<Edit>,
-    /// Final tokens `[part][layer][step]`.
+    /// Final tokens `[part][layer][step]`, with the base motion's codes under the body-part
+    /// clips ([`MotionTokens::base_patches`]).
     pub tokens: MotionTokens,
     /// What the decoder could not read and dropped (a plan or record that does not read), for
     /// the user; never written into a link.
@@ -211,6 +222,20 @@ fn payload(motion: &SharedMotion) -> Vec<u8> {
         bits.put(*code);
     }
     out.extend(bits.finish());
+    // Checked patches: parts 0..4, within the steps, at most one per step of a part.
+    let patches = tokens.base_patches();
+    put_varint(&mut out, patches.len() as u64);
+    for patch in patches {
+        let steps = patch.steps();
+        out.push(patch.part as u8);
+        put_varint(&mut out, steps.start as u64);
+        put_varint(&mut out, steps.len() as u64);
+        let mut bits = BitWriter::default();
+        for code in patch.codes.iter().flatten() {
+            bits.put(*code);
+        }
+        out.extend(bits.finish());
+    }
     out
 }
 
@@ -297,6 +322,24 @@ impl Reader<'_> {
         Ok(v as usize)
     }
 
+    /// `count` codes of 9 bits, packed little-endian from the next byte.
+    fn codes(&mut self, count: usize) -> Result<Vec<u32>, LinkError> {
+        let packed = self.bytes((count * 9).div_ceil(8))?;
+        let mut codes = Vec::with_capacity(count);
+        let (mut acc, mut n, mut at) = (0u32, 0u32, 0usize);
+        while codes.len() < count {
+            while n < 9 {
+                acc |= (*packed.get(at).ok_or(LinkError::Truncated)? as u32) << n;
+                at += 1;
+                n += 8;
+            }
+            codes.push(acc & 0x1ff);
+            acc >>= 9;
+            n -= 9;
+        }
+        Ok(codes)
+    }
+
     fn text(&mut self, max: usize, what: &str) -> Result<String, LinkError> {
         let n = self.bounded(max as u64, &format!("the {what}'s length"))?;
         let raw = self.bytes(n)?;
@@ -334,7 +377,7 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
         return Err(LinkError::BadMagic);
     }
     let version = r.byte()?;
-    if version != VERSION && version != VERSION_1 {
+    if ![VERSION_1, VERSION_2, VERSION].contains(&version) {
         return Err(LinkError::UnknownVersion(version));
     }
     let mut model_id = [0u8; 8];
@@ -391,19 +434,24 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
     if steps == 0 {
         return Err(LinkError::Invalid("the motion is empty".into()));
     }
-    let count = parts * layers * steps;
-    let packed = r.bytes((count * 9).div_ceil(8))?;
-    let mut codes = Vec::with_capacity(count);
-    let (mut acc, mut n, mut at) = (0u32, 0u32, 0usize);
-    while codes.len() < count {
-        while n < 9 {
-            acc |= (*packed.get(at).ok_or(LinkError::Truncated)? as u32) << n;
-            at += 1;
-            n += 8;
+    let codes = r.codes(parts * layers * steps)?;
+    let mut patches = Vec::new();
+    if version >= VERSION {
+        // Patches of one part never overlap and cover a step at least: at most one per step.
+        let count = r.bounded((parts * steps) as u64, "the number of base patches")?;
+        for _ in 0..count {
+            let part = r.byte()? as usize;
+            let start = r.bounded(steps as u64 - 1, "a base patch's first step")?;
+            let len = r.bounded((steps - start) as u64, "a base patch's length")?;
+            let mut codes = r.codes(layers * len)?.into_iter();
+            patches.push(BasePatch {
+                part,
+                start,
+                codes: (0..layers)
+                    .map(|_| codes.by_ref().take(len).collect())
+                    .collect(),
+            });
         }
-        codes.push(acc & 0x1ff);
-        acc >>= 9;
-        n -= 9;
     }
     if r.at != payload.len() {
         return Err(LinkError::Invalid(
@@ -420,6 +468,7 @@ fn parse_payload(payload: &[u8]) -> Result<SharedMotion, LinkError> {
             })
             .collect(),
     )
+    .and_then(|tokens| tokens.with_base(patches))
     .map_err(|e| LinkError::Invalid(e.to_string()))?;
     let plan = LinkPlan::from_json(&plan, tokens.frames()).unwrap_or_else(|e| {
         notes.push(format!(

@@ -52,6 +52,24 @@ fn sample(steps: usize) -> SharedMotion {
     }
 }
 
+/// [`sample`] with body-part clips laid as layers: the base codes of the left arm over steps
+/// 5..15 and of the right leg from step `steps − 9` to the end.
+fn layered(steps: usize) -> SharedMotion {
+    let mut motion = sample(steps);
+    let patch = |part, start, len: usize| BasePatch {
+        part,
+        start,
+        codes: (0..4)
+            .map(|l| (0..len).map(|s| ((l * 37 + s * 11) % 512) as u32).collect())
+            .collect(),
+    };
+    motion.tokens = motion
+        .tokens
+        .with_base(vec![patch(0, 5, 10), patch(3, steps - 9, 9)])
+        .unwrap();
+    motion
+}
+
 #[test]
 fn a_motion_survives_the_round_trip_in_any_form_of_link() {
     let motion = sample(49);
@@ -65,6 +83,65 @@ fn a_motion_survives_the_round_trip_in_any_form_of_link() {
     let url = format!("http://127.0.0.1:8080/index.html#{fragment}");
     assert_eq!(decode(&url).unwrap(), motion);
     assert_eq!(decode(&format!("#x=1&{fragment}")).unwrap(), motion);
+}
+
+#[test]
+fn the_base_under_the_clips_survives_the_round_trip() {
+    let motion = layered(49);
+    assert_eq!(motion.tokens.base_patches().len(), 2);
+    let back = decode(&encode(&motion)).unwrap();
+    assert_eq!(back, motion);
+    assert_eq!(back.tokens.base(), motion.tokens.base());
+    // The patches cost their codes, 9 bits each, and a few bytes apiece.
+    let plain = payload(&sample(49)).len();
+    let codes = (4 * 10 * 9usize).div_ceil(8) + (4 * 9 * 9usize).div_ceil(8);
+    assert!(
+        payload(&motion).len() <= plain + codes + 8,
+        "{}",
+        payload(&motion).len()
+    );
+}
+
+#[test]
+fn a_truncated_or_oversized_list_of_base_patches_is_refused() {
+    let good = payload(&layered(20));
+    assert!(parse_payload(&good).is_ok());
+    // Cut anywhere in the patches: the link ends too early.
+    let plain = payload(&sample(20)).len();
+    for cut in plain..good.len() {
+        assert_eq!(
+            parse_payload(&good[..cut]),
+            Err(LinkError::Truncated),
+            "cut at {cut}"
+        );
+    }
+    // More patches than the motion has steps of parts.
+    let mut many = payload(&sample(20));
+    many.pop();
+    many.extend_from_slice(&[81, 0, 0, 1, 0, 0, 0, 0, 0]);
+    let e = parse_payload(&many).unwrap_err();
+    assert!(e.to_string().contains("base patches is 81"), "{e}");
+    // One patch past the motion's end, one on a fifth part, two overlapping.
+    let patch = |part: u8, start: u8, len: u8| {
+        let mut p = vec![part, start, len];
+        p.extend(std::iter::repeat_n(0, (4 * len as usize * 9).div_ceil(8)));
+        p
+    };
+    for (patches, why) in [
+        (vec![patch(0, 18, 3)], "length"),
+        (vec![patch(0, 20, 1)], "first step"),
+        (vec![patch(0, 3, 0)], "at least one step"),
+        (vec![patch(4, 0, 1)], "body part 4"),
+        (vec![patch(1, 0, 3), patch(1, 2, 2)], "overlap"),
+    ] {
+        let mut p = payload(&sample(20));
+        p.pop();
+        p.push(patches.len() as u8);
+        p.extend(patches.concat());
+        let e = parse_payload(&p).unwrap_err();
+        assert!(matches!(e, LinkError::Invalid(_)), "{e:?}");
+        assert!(e.to_string().contains(why), "{e}");
+    }
 }
 
 #[test]
@@ -133,7 +210,7 @@ fn broken_links_give_clear_errors() {
         )
     };
     let mut future = payload(&sample(10));
-    future[2] = 3;
+    future[2] = 4;
     let mut header = b"CM\x01".to_vec();
     header.extend_from_slice(&id);
     let cases: Vec<(String, LinkError)> = vec![
@@ -153,7 +230,7 @@ fn broken_links_give_clear_errors() {
         ),
         (link(b"XY\x01"), LinkError::BadMagic),
         (link(b""), LinkError::BadMagic),
-        (link(&future), LinkError::UnknownVersion(3)),
+        (link(&future), LinkError::UnknownVersion(4)),
         (link(&header), LinkError::Truncated),
         (
             good[..good.len() / 2].to_string(),
@@ -170,9 +247,28 @@ fn broken_links_give_clear_errors() {
         }
     }
     // Every error reads as a sentence for the page.
-    assert!(LinkError::UnknownVersion(3)
+    assert!(LinkError::UnknownVersion(4)
         .to_string()
         .contains("newer version"));
+}
+
+#[test]
+fn links_of_the_second_version_still_open() {
+    // Version 2 is version 3 without the base patches: cut the empty list (one zero byte).
+    let motion = sample(7);
+    let mut v2 = payload(&motion);
+    assert_eq!(v2.pop(), Some(0), "no patches is one zero count byte");
+    v2[2] = 2;
+    let opened = parse_payload(&v2).unwrap();
+    assert_eq!(opened, motion);
+    assert!(opened.tokens.base_patches().is_empty());
+    // A version 2 payload has nothing after its tokens: a patch list there is refused.
+    let mut layered_v2 = payload(&layered(20));
+    layered_v2[2] = 2;
+    assert!(matches!(
+        parse_payload(&layered_v2),
+        Err(LinkError::Invalid(_))
+    ));
 }
 
 #[test]
@@ -180,7 +276,9 @@ fn links_of_the_first_version_still_open() {
     // Version 1 is version 2 without the record: cut the record out of a version 2 payload.
     let mut motion = sample(7);
     motion.record = None;
-    let v2 = payload(&motion);
+    let mut v2 = payload(&motion);
+    v2.pop();
+    v2[2] = 2;
     let plan = motion.plan.to_json();
     let record_at = 3 + 8 + 1 + (1 + motion.prompt.len()) + (1 + plan.len());
     assert_eq!(v2[record_at], 0, "an empty record is one zero length byte");
@@ -235,6 +333,7 @@ fn the_decoder_survives_a_million_random_and_mutated_links() {
     let seeds: Vec<Vec<u8>> = [1usize, 10, 49, 196]
         .iter()
         .map(|&s| payload(&sample(s)))
+        .chain([payload(&layered(20))])
         .collect();
     let fragments: Vec<String> = [1usize, 10, 49]
         .iter()
