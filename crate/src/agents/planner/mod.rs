@@ -11,4 +11,5 @@ pub mod meaning;
 pub mod offline;
 pub mod postures;
 pub mod prompt_set;
+pub mod sided;
 pub mod timeline_set;

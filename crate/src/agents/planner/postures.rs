@@ -655,7 +655,8 @@ pub fn plan_clause(
                 // "reaches up high with the left hand": the posture of both arms, on one.
                 match one_arm_after(&text[r.end..]).filter(|_| p.parts.len() == 2 && arms_only(p)) {
                     Some(one) => one_arm_of(p, one).unwrap_or_else(|| on_arm(p, arm)),
-                    None => on_arm(p, arm),
+                    // "kneels on the left knee": a one-legged posture on the leg named.
+                    None => on_arm(&super::sided::on_leg(p, words), arm),
                 },
             ),
             Named::Action(_) => None,
