@@ -241,11 +241,39 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 }
                 break 'clause;
             }
+            // "stretches her left arm to the side, and then the right one": the places held
+            // over the clause before, on the side asked, over its movement once more.
+            let held_before = held
+                .last()
+                .map(|(span, _)| span.clone())
+                .filter(|span| span.end == clause_start && !span.is_empty());
+            if let Some((span, poses)) = model
+                .is_none()
+                .then(|| anaphora::again(words))
+                .flatten()
+                .zip(held_before)
+                .and_then(|(a, span)| {
+                    let poses: Vec<NamedPosture> = held
+                        .iter()
+                        .filter(|(s, _)| *s == span)
+                        .map(|(_, p)| p.clone())
+                        .collect();
+                    Some((span, anaphora::repeated_poses(&poses, a)?))
+                })
+            {
+                segments.extend(segments[span].to_vec());
+                let again = clause_start..segments.len();
+                held.extend(poses.into_iter().map(|p| (again.clone(), p)));
+                break 'clause;
+            }
             if let Some(once_more) = model
                 .is_none()
                 .then(|| anaphora::again(words))
                 .flatten()
-                .and_then(|a| anaphora::repeated(segments.last()?, a))
+                .and_then(|a| {
+                    let last = segments.iter().rev().find(|s| !anaphora::is_lowering(s))?;
+                    anaphora::repeated(last, a)
+                })
             {
                 // "waves with the left hand, then with the right".
                 segments.push(once_more);
@@ -401,7 +429,12 @@ fn lowered_back(words: &[&str], before: Option<&Segment>) -> Option<Segment> {
     if !anaphora::lowers_back(words) {
         return None;
     }
-    let arms = anaphora::raised_arms(before?);
+    let before = before?;
+    let mut arms = anaphora::raised_arms(before);
+    if arms.is_empty() {
+        // "waves with the left hand, lowers it": the arm the movement before used.
+        arms = anaphora::moved_arms(before);
+    }
     let stand = Library::builtin().get("stand")?;
     let which = match arms.as_slice() {
         [BodyPart::LeftArm] => "the left arm",
@@ -410,7 +443,7 @@ fn lowered_back(words: &[&str], before: Option<&Segment>) -> Option<Segment> {
         _ => "both arms",
     };
     let mut script = stand.script.clone();
-    script.name = Some("arms down".into());
+    script.name = Some(anaphora::ARMS_DOWN.into());
     Some(Segment {
         text: format!("a person lowers {which}"),
         seconds: 2.0,

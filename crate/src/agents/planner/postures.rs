@@ -422,7 +422,10 @@ pub fn stay(words: &[&str]) -> Option<Stay> {
     // "holds the pose", "holds it there": holding what there is, not an object.
     let holds_it = words.windows(2).any(|w| {
         matches!(w[0], "hold" | "holds" | "holding")
-            && matches!(w[1], "it" | "that" | "this" | "there" | "still" | "steady")
+            && matches!(
+                w[1],
+                "it" | "them" | "that" | "this" | "there" | "still" | "steady"
+            )
     }) || words.windows(3).any(|w| {
         matches!(w[0], "hold" | "holds" | "holding")
             && matches!(w[1], "the" | "that" | "this" | "his" | "her" | "their")

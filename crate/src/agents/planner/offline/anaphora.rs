@@ -7,21 +7,21 @@
 
 use super::super::lexicon::Side;
 use crate::plan::Segment;
+use crate::posture::library::NamedPosture;
 use crate::skeleton::BodyPart;
 
 /// Whether a clause lowers something it points back at ("lowers it", "puts them back down",
 /// "brings the arm down", "drops the hands"), naming no other movement.
 pub(super) fn lowers_back(words: &[&str]) -> bool {
-    let lowering = words
-        .iter()
-        .any(|w| matches!(*w, "lower" | "lowers" | "lowering"))
+    let has = |list: &[&str]| words.iter().any(|w| list.contains(w));
+    let lowering = has(&["lower", "lowers", "lowering"])
         || words.contains(&"down")
-            && words.iter().any(|w| {
-                matches!(
-                    *w,
-                    "put" | "puts" | "bring" | "brings" | "take" | "takes" | "drop" | "drops"
-                )
-            });
+            && has(&[
+                "put", "puts", "bring", "brings", "take", "takes", "drop", "drops",
+            ])
+        // "lets them drop", "lets the arms fall", "drops the hands".
+        || has(&["let", "lets", "letting"]) && has(&["drop", "fall", "hang", "sink"])
+        || has(&["drop", "drops", "dropping"]);
     let pointer = words.iter().any(|w| {
         matches!(
             *w,
@@ -69,6 +69,50 @@ pub(super) fn raised_arms(segment: &Segment) -> Vec<BodyPart> {
         _ => vec![BodyPart::LeftArm, BodyPart::RightArm],
     }
 }
+
+/// The arms the segment moves on their own, when none is raised: the arms with an
+/// instruction of their own or held in a posture of the arms, else the side its base motion
+/// names for a hand or an arm ("a person waves the left hand").
+pub(super) fn moved_arms(segment: &Segment) -> Vec<BodyPart> {
+    let arms = [BodyPart::LeftArm, BodyPart::RightArm];
+    let edited: Vec<BodyPart> = arms
+        .into_iter()
+        .filter(|p| segment.parts.get(*p).is_some())
+        .collect();
+    if !edited.is_empty() {
+        return edited;
+    }
+    if let Some(track) = &segment.postures {
+        if track.parts.iter().all(|p| arms.contains(p)) {
+            return track.parts.clone();
+        }
+    }
+    let words: Vec<&str> = segment.base.split(' ').collect();
+    if !words
+        .iter()
+        .any(|w| matches!(*w, "hand" | "hands" | "arm" | "arms"))
+    {
+        return Vec::new();
+    }
+    match (words.contains(&"left"), words.contains(&"right")) {
+        (true, false) => vec![BodyPart::LeftArm],
+        (false, true) => vec![BodyPart::RightArm],
+        _ => arms.to_vec(),
+    }
+}
+
+/// Whether a segment only brings arms down (made by the built-in planner for "lowers it"):
+/// "does it again" after it means the movement before the lowering.
+pub(super) fn is_lowering(segment: &Segment) -> bool {
+    segment.postures.as_ref().is_some_and(|t| {
+        t.keys
+            .iter()
+            .all(|k| k.script.name.as_deref() == Some(ARMS_DOWN))
+    })
+}
+
+/// The name of the key pose that brings the arms down.
+pub(super) const ARMS_DOWN: &str = "arms down";
 
 /// What a clause that only points back asks of the movement before it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,19 +193,63 @@ pub(super) fn repeated(segment: &Segment, again: Again) -> Option<Segment> {
     })
 }
 
+/// Text with its sides swapped ("left arm up" is "right arm up").
+fn swap(text: &str) -> String {
+    text.split(' ')
+        .map(|w| match w {
+            "left" => "right",
+            "right" => "left",
+            other => other,
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Limb places held over the clause before, made once more as `again` asks ("stretches her
+/// left arm to the side, and then the right one"); `None` when a side is asked of places
+/// that have none (both arms, or limbs of both sides).
+pub(super) fn repeated_poses(poses: &[NamedPosture], again: Again) -> Option<Vec<NamedPosture>> {
+    let side = |p: &BodyPart| match p {
+        BodyPart::LeftArm | BodyPart::LeftLeg => Side::Left,
+        BodyPart::RightArm | BodyPart::RightLeg => Side::Right,
+    };
+    let sides: Vec<Side> = poses
+        .iter()
+        .flat_map(|p| p.parts.iter().map(side))
+        .collect();
+    let own = match sides.split_first() {
+        Some((first, rest)) if rest.iter().all(|s| s == first) => Some(*first),
+        _ => None,
+    };
+    let mirror = match (again, own) {
+        (Again::Same, _) => false,
+        (Again::Other, Some(_)) => true,
+        (Again::On(want), Some(own)) => want != own,
+        (Again::Other | Again::On(_), None) => return None,
+    };
+    Some(
+        poses
+            .iter()
+            .map(|p| {
+                if !mirror {
+                    return p.clone();
+                }
+                let mut script = p.script.mirrored();
+                script.name = script.name.as_deref().map(swap);
+                NamedPosture {
+                    name: swap(&p.name),
+                    synonyms: Vec::new(),
+                    parts: p.parts.iter().map(|b| b.mirrored()).collect(),
+                    script,
+                }
+            })
+            .collect(),
+    )
+}
+
 /// A segment with its left and right swapped: the words, the part instructions and the key
 /// poses.
 fn mirrored(segment: &Segment) -> Segment {
-    let swap = |text: &str| {
-        text.split(' ')
-            .map(|w| match w {
-                "left" => "right",
-                "right" => "left",
-                other => other,
-            })
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
     let mut out = segment.clone();
     out.text = swap(&segment.text);
     out.base = swap(&segment.base);

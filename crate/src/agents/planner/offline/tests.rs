@@ -992,3 +992,44 @@ fn a_posture_keeps_its_limbs_when_another_clause_moves_others() {
         "{plan:#?}"
     );
 }
+
+#[test]
+fn lowering_and_repeating_point_back_at_the_arm_that_moved() {
+    // "lowers it" after a wave brings that arm down; "does it again" waves, not lowers.
+    let plan = plan(
+        "Someone waves with the left hand, lowers it, and does it again.",
+        None,
+    );
+    let bases: Vec<&str> = plan.segments.iter().map(|s| s.base.as_str()).collect();
+    assert_eq!(
+        bases,
+        [
+            "a person waves the left hand",
+            "a person stands still",
+            "a person waves the left hand"
+        ],
+        "{plan:#?}"
+    );
+    let down = plan.segments[1].postures.as_ref().expect("arms down");
+    assert_eq!(down.parts, [BodyPart::LeftArm]);
+    // "lets them drop" lowers what was raised.
+    let drop = super::plan("A woman raises both hands, then lets them drop.", None);
+    assert_eq!(drop.segments.len(), 2, "{drop:#?}");
+    assert_eq!(drop.segments[1].text, "a person lowers both arms");
+}
+
+#[test]
+fn the_other_one_holds_the_place_before_on_the_other_side() {
+    let plan = plan(
+        "The woman stretches her left arm to the side, and then the right one.",
+        None,
+    );
+    assert_eq!(plan.segments.len(), 2, "{plan:#?}");
+    let parts: Vec<Vec<BodyPart>> = plan.clips.iter().map(|c| c.parts.clone()).collect();
+    assert_eq!(
+        parts,
+        [vec![BodyPart::LeftArm], vec![BodyPart::RightArm]],
+        "{plan:#?}"
+    );
+    assert!(plan.clips[1].start >= plan.clips[0].end - 1e-9);
+}
