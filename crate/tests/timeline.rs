@@ -49,12 +49,17 @@ fn run(session: &Session, plan: &Plan) -> Motion {
 
 /// A walk then a run, 5 s each, and a wave of the left hand from `start` to `end` seconds.
 fn walk_run(wave: Option<(f64, f64)>) -> Plan {
+    walk_run_with(BodyPart::LeftArm, "a person waves the left hand", wave)
+}
+
+/// A walk then a run, 5 s each, and a clip of `text` on `part` from `start` to `end` seconds.
+fn walk_run_with(part: BodyPart, text: &str, span: Option<(f64, f64)>) -> Plan {
     let mut plan = offline::plan("a person walks forward, then runs forward", None);
     plan.fit_seconds(10.0);
-    plan.clips = wave
+    plan.clips = span
         .map(|(start, end)| Clip {
-            parts: vec![BodyPart::LeftArm],
-            text: "a person waves the left hand".into(),
+            parts: vec![part],
+            text: text.into(),
             start,
             end,
             postures: None,
@@ -235,4 +240,48 @@ fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_a
         },
     );
     assert_eq!(again.joints, with.joints);
+}
+
+#[test]
+fn a_legs_clip_moved_leaves_the_frames_outside_its_spans_as_they_were() {
+    // Planting the feet carries the body by its feet over the whole motion and puts the lowest
+    // contact on the floor: a kick finished with the rest of the motion would move every frame
+    // after it. The base is finished on its own, so it does not.
+    let session = session();
+    let kick = "a person kicks with the right leg";
+    let plan = walk_run_with(BodyPart::RightLeg, kick, Some((3.0, 5.0)));
+    let with = run(&session, &plan);
+    let moved_plan = walk_run_with(BodyPart::RightLeg, kick, Some((6.0, 8.0)));
+    let moved_clip = execute(
+        &session,
+        Command::EditClips {
+            tokens: with.tokens.clone(),
+            before: plan.clone(),
+            plan: moved_plan.clone(),
+            seed: 11,
+        },
+    );
+    let (old, new) = (
+        clip_steps(&plan, &plan.clips[0], &with.tokens),
+        clip_steps(&moved_plan, &moved_plan.clips[0], &moved_clip.tokens),
+    );
+    let both = old.start.min(new.start)..old.end.max(new.end);
+    let (a, b) = (joints(&with), joints(&moved_clip));
+    let (before, after) = (
+        moved(&a, &b, 0..both.start * FRAMES_PER_TOKEN),
+        moved(&a, &b, both.end * FRAMES_PER_TOKEN..a.len()),
+    );
+    eprintln!(
+        "moving a kick, joints outside the affected steps {both:?}: up to {:.4} mm before, \
+         {:.4} mm after (relative to the pelvis); {:.4} mm before, {:.4} mm after in world space",
+        before.0 * 1e3,
+        after.0 * 1e3,
+        before.1 * 1e3,
+        after.1 * 1e3
+    );
+    for d in [before.0, before.1, after.0, after.1] {
+        assert!(d < UNCHANGED_M, "{d} m");
+    }
+    // Every bone keeps its length under the clip too, where the kick eases in and out.
+    assert!(coma::skeleton::max_bone_deviation(&b) < 1e-3);
 }

@@ -24,7 +24,7 @@
 //! where the tokens move into and out of the clip), except at the motion's own first and last
 //! frame; outside every patch it is 0, and the base's numbers are kept bit for bit.
 
-use super::{FeatureFrame, Features, CONTACTS, POSITIONS, ROTATIONS, VELOCITIES};
+use super::{FeatureFrame, Features, CONTACTS, POSITIONS, ROOT_HEIGHT, ROTATIONS, VELOCITIES};
 use crate::geom;
 use crate::model::edit::SEAM_STEPS;
 use crate::model::tokens::{MotionTokens, PARTS};
@@ -97,6 +97,10 @@ fn joint_columns(j: usize) -> impl Iterator<Item = usize> {
 /// its [`joint_weight`], and each leg's foot contacts by the leg's weight; the root's columns
 /// are the base's. `weights` are [`layer_weights`]; a row without one (or past `layered`) is
 /// the base's. Where a weight is 0 the base's numbers are kept exactly.
+///
+/// A joint's height (stored above the floor, not above the pelvis) is taken from `layered`
+/// relative to its pelvis and put on the base's pelvis, so a limb stays on the body where the
+/// two motions carry the pelvis at different heights.
 pub fn compose(
     base: &[FeatureFrame],
     layered: &[FeatureFrame],
@@ -113,6 +117,11 @@ pub fn compose(
             let (Some(w), Some(top)) = (weights.get(t), layered.get(t)) else {
                 return out;
             };
+            let mut top = *top;
+            let lift = row[ROOT_HEIGHT.start] - top[ROOT_HEIGHT.start];
+            for j in 1..NUM_JOINTS {
+                top[POSITIONS.start + (j - 1) * 3 + 1] += lift;
+            }
             let mut mix = |cols: &mut dyn Iterator<Item = usize>, k: f32| {
                 if k <= 0.0 {
                     return;
@@ -139,7 +148,7 @@ pub fn compose(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::features::{FEATURE_DIM, ROOT_HEIGHT, ROOT_LIN_VEL, ROOT_ROT_VEL};
+    use crate::features::{FEATURE_DIM, ROOT_LIN_VEL, ROOT_ROT_VEL};
     use crate::model::tokens::BasePatch;
 
     /// 30 steps (120 frames) of 1 layer, with a left-arm patch over steps 10..15.
@@ -189,13 +198,22 @@ mod tests {
         let tokens = left_arm_clip();
         let weights = layer_weights(&tokens);
         let base: Features = (0..120).map(|t| [t as f32; FEATURE_DIM]).collect();
-        let layered: Features = (0..120).map(|t| [1000.0 + t as f32; FEATURE_DIM]).collect();
+        let mut layered: Features = (0..120).map(|t| [1000.0 + t as f32; FEATURE_DIM]).collect();
+        // The same pelvis height as the base's, but for frame 50's, 0.25 m lower.
+        for (t, row) in layered.iter_mut().enumerate() {
+            row[ROOT_HEIGHT.start] = t as f32 - if t == 50 { 0.25 } else { 0.0 };
+        }
         let out = compose(&base, &layered, &weights);
+        // Frame 50's arm is as high above its pelvis as in the layer.
+        let wrist_y = POSITIONS.start + (joint::L_WRIST - 1) * 3 + 1;
+        assert_eq!(out[50][wrist_y], 1050.25);
+        layered[50][ROOT_HEIGHT.start] = 50.0;
         let cols_of = |joints: &[usize]| -> Vec<usize> {
             joints.iter().flat_map(|&j| joint_columns(j)).collect()
         };
         let arm = cols_of(BodyPart::LeftArm.limb_joints());
         assert_eq!(arm.len(), 4 * 12);
+        let out = compose(&base, &layered, &weights);
         for (t, row) in out.iter().enumerate() {
             for c in 0..FEATURE_DIM {
                 let expected = if arm.contains(&c) {

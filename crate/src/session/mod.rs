@@ -26,8 +26,8 @@ use crate::agents::pipeline::{self, RunOptions};
 use crate::agents::reviewer::Scorer;
 use crate::dataset::Vocabulary;
 use crate::features::{
-    features_to_joints, reference_fit, with_reference_bones, with_reference_bones_fitted,
-    FeatureFrame, Features,
+    features_to_joints, layers, reference_fit, with_reference_bones, with_reference_bones_fitted,
+    FeatureFrame, Features, VELOCITIES,
 };
 use crate::feet::plant_feet;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
@@ -35,7 +35,7 @@ use crate::model::motion_model::sampling;
 use crate::model::tokens::MotionTokens;
 use crate::model::MotionModel;
 use crate::plan::Plan;
-use crate::skeleton::BodyPart;
+use crate::skeleton::{lowest_joint, BodyPart, SkeletonFit};
 use crate::timing::{frames_for_seconds, seconds};
 use progress::{run_event_line, run_steps, Steps};
 
@@ -324,20 +324,18 @@ impl Session {
         Ok(Outcome::Motion { motion, notes })
     }
 
-    /// The motion of `tokens` with the paths of `plan` laid on its root; the notes say which
-    /// paths could not be laid.
-    ///
-    /// Every motion the engine answers with is made here, and here it gets the one skeleton
-    /// ([`with_reference_bones`]): the model predicts each joint on its own, so its bones
-    /// stretch; fixed once in the features, the joints shown, the BVH, the JSON and both NPY
-    /// exports all describe the same motion on the same bones. Here too its feet are planted
-    /// ([`plant_feet`]), whatever made it.
+    /// The motion of `tokens` with the paths of `plan` laid on its root, finished (see
+    /// [`finished`]); the notes say which paths could not be laid and which key poses could
+    /// not be met in full.
     ///
     /// Body-part clips laid as layers on the tokens are composed over the base motion
-    /// ([`crate::features::layers`]), and the one skeleton is fitted on the base motion: what
-    /// follows is frame by frame (the paths read only the root, which is the base's), so the
-    /// frames outside the clips' spans are the base motion's exactly. Only planting the feet
-    /// reads the legs across time (a leg's clip changes where the body is carried after it).
+    /// ([`crate::features::layers`]) where the tokens turn into features, and once more at
+    /// the end: the base motion is finished on its own (skeleton, key postures, planted feet)
+    /// and the clips' parts are taken over their spans from the motion finished with them.
+    /// Fitting the skeleton, laying key poses and planting the feet read the whole motion (a
+    /// mean shape of the hips and collars, the floor, where the feet carry the body), so a
+    /// clip would otherwise still move frames outside its span, a leg's clip most; this way
+    /// the frames outside the clips' spans are the base motion's exactly, whatever the clip.
     async fn motion(&self, tokens: MotionTokens, plan: Option<&Plan>) -> (Motion, Vec<String>) {
         let (features, base, notes) = match plan {
             Some(plan) => pipeline::motion_features_and_base(&self.model, plan, &tokens).await,
@@ -346,25 +344,33 @@ impl Session {
                 (features, base, Vec::new())
             }
         };
+        // One skeleton for both, the base's: its triangles and floor do not follow a clip.
         let fit = reference_fit(base.as_deref().unwrap_or(&features));
-        let features = with_reference_bones_fitted(&features, &fit);
-        let (features, notes) = match plan {
-            Some(plan)
-                if plan.segments.iter().any(|s| s.postures.is_some())
-                    || plan.clips.iter().any(|c| c.postures.is_some()) =>
-            {
-                let (laid, posture_notes) = pipeline::lay_postures(plan, &tokens, &features);
-                // Key poses keep the bone lengths but shape the hips and collars their own
-                // way, which a rigid skeleton (the BVH's) cannot follow: once more on the
-                // one skeleton, so posture-built motions leave here as every other does.
-                let laid = with_reference_bones(&laid);
-                (laid, notes.into_iter().chain(posture_notes).collect())
+        let (features, posture_notes) = finished(&features, &fit, &tokens, plan);
+        let features = match base {
+            None => features,
+            Some(base) => {
+                let (base, _) = finished(&base, &fit, &tokens, plan);
+                let weights = layers::layer_weights(&tokens);
+                let mut composed = layers::compose(&base, &features, &weights);
+                // Joint by joint, easing between two poses shortens bones: the frames under a
+                // clip once more on the one skeleton, no lower than the finished base stands
+                // (and the velocities of the frame before, which lead into them). The others
+                // are the base's as they are.
+                let mut fit = fit;
+                fit.floor = lowest_joint(&features_to_joints(&base));
+                let fixed = with_reference_bones_fitted(&composed, &fit);
+                let under = |t: usize| weights.get(t).is_some_and(|w| w.iter().any(|&x| x > 0.0));
+                for (t, row) in composed.iter_mut().enumerate() {
+                    if under(t) {
+                        *row = fixed[t];
+                    } else if under(t + 1) {
+                        row[VELOCITIES].copy_from_slice(&fixed[t][VELOCITIES]);
+                    }
+                }
+                composed
             }
-            _ => (features, notes),
         };
-        // Feet planted last, on whatever was laid, so every motion leaves with them.
-        let paths = plan.map_or_else(Vec::new, |plan| pipeline::path_ranges(plan, &tokens));
-        let features = plant_feet(&features, &paths);
         let joints = features_to_joints(&features)
             .iter()
             .map(|p| p.map(|j| j.map(|v| v as f32)))
@@ -374,8 +380,42 @@ impl Session {
             joints,
             features,
         };
-        (motion, notes)
+        (motion, notes.into_iter().chain(posture_notes).collect())
     }
+}
+
+/// Features with their paths laid (not normalised, 20 fps) as the engine hands them out: on
+/// the reference skeleton of `fit`, the plan's key postures laid, the feet planted; with the
+/// notes of the key poses that could not be met in full.
+///
+/// Every motion the engine answers with is finished here, and here it gets the one skeleton
+/// ([`with_reference_bones`]): the model predicts each joint on its own, so its bones
+/// stretch; fixed once in the features, the joints shown, the BVH, the JSON and both NPY
+/// exports all describe the same motion on the same bones. Here too its feet are planted
+/// ([`plant_feet`]), whatever made it.
+fn finished(
+    features: &[FeatureFrame],
+    fit: &SkeletonFit,
+    tokens: &MotionTokens,
+    plan: Option<&Plan>,
+) -> (Features, Vec<String>) {
+    let features = with_reference_bones_fitted(features, fit);
+    let (features, notes) = match plan {
+        Some(plan)
+            if plan.segments.iter().any(|s| s.postures.is_some())
+                || plan.clips.iter().any(|c| c.postures.is_some()) =>
+        {
+            let (laid, notes) = pipeline::lay_postures(plan, tokens, &features);
+            // Key poses keep the bone lengths but shape the hips and collars their own
+            // way, which a rigid skeleton (the BVH's) cannot follow: once more on the
+            // one skeleton, so posture-built motions leave here as every other does.
+            (with_reference_bones(&laid), notes)
+        }
+        _ => (features, Vec::new()),
+    };
+    // Feet planted last, on whatever was laid, so every motion leaves with them.
+    let paths = plan.map_or_else(Vec::new, |plan| pipeline::path_ranges(plan, tokens));
+    (plant_feet(&features, &paths), notes)
 }
 
 /// Decoded features (not normalised) as the engine hands them out when no plan lays paths or
