@@ -49,6 +49,7 @@ mod context;
 mod limb_poses;
 mod limbs;
 mod substitutes;
+mod torso_poses;
 mod tracks;
 
 use clauses::{clauses, tokens};
@@ -169,6 +170,27 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                     style.as_deref(),
                 ),
             };
+            if let Some(pose) = model
+                .is_none()
+                .then(|| torso_poses::torso_pose(words))
+                .flatten()
+            {
+                // "leans to the left": the standing body with its trunk held so.
+                let track = PostureTrack::holding(pose.parts, pose.script);
+                segments.push(Segment {
+                    text: format!("a person {}", lexicon::without_subject(words).join(" ")),
+                    seconds: clamp_seconds(track.natural_seconds() + DEFAULT_TRANSITION_SECONDS)
+                        .unwrap_or(2.0)
+                        .max(2.0),
+                    base: "a person stands still".into(),
+                    parts: PartEdits::default(),
+                    trajectory: None,
+                    postures: Some(track),
+                });
+                previous = None;
+                ends_standing = None;
+                break 'clause;
+            }
             let model_parts = model.as_ref().map(|m| (m.base, m.gestures.as_slice()));
             if let Some(planned) = postures::plan_clause(words, model_parts, &model_segment) {
                 notes.extend(planned.notes);

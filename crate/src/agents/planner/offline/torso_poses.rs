@@ -1,0 +1,170 @@
+//! A held pose of the torso read from the words ("leans to the left", "bends forward",
+//! "stretches into a side bend to the right", "twists the upper body to the left", "looks
+//! over the right shoulder"): the standing body with the trunk leaning or turned, as
+//! pose-code constraints the posture solver meets (the lean and twist codes of CoMo's
+//! vocabulary). The model has no torso of its own to edit (its parts are the four limbs), so
+//! the pose is a key pose of the whole body, standing; the built-in planner makes it the
+//! clause's segment when the clause names nothing else.
+
+use crate::posecodes::{Lean, PelvisLevel, Twist};
+use crate::posture::library::NamedPosture;
+use crate::posture::script::{Constraint, PostureScript};
+use crate::skeleton::{BodyPart, Side};
+
+/// Seconds the pose is held once reached.
+const HOLD_SECONDS: f64 = 1.0;
+
+/// Verbs of a lean or a bend of the trunk.
+const LEANING: &[&str] = &[
+    "lean", "leans", "leaning", "bend", "bends", "bending", "tilt", "tilts", "tilting", "sway",
+    "sways", "swaying",
+];
+
+/// Verbs of a turn of the trunk, or of a look that turns it ("looks over the right
+/// shoulder").
+const TURNING: &[&str] = &[
+    "twist", "twists", "twisting", "rotate", "rotates", "rotating", "look", "looks", "looking",
+    "glance", "glances", "glancing",
+];
+
+/// Words that say the whole trunk goes, not a limb: "bends **down** to pick up" is a
+/// movement of the model, "leans **on** the wall" none of the torso.
+const ELSEWHERE: &[&str] = &[
+    "down", "on", "against", "arm", "arms", "hand", "hands", "leg", "legs", "knee", "knees",
+    "head", "foot", "feet",
+];
+
+/// The torso pose a clause asks for, if it asks only that: the lean or twist and its name
+/// ("leaning to the left"); `None` when the words name no way for the trunk to go.
+pub(super) fn torso_pose(words: &[&str]) -> Option<NamedPosture> {
+    let has = |list: &[&str]| words.iter().any(|w| list.contains(w));
+    // "bends forward to touch his toes": the purpose is a posture or a movement of its own.
+    let purpose = words
+        .windows(2)
+        .any(|w| w[0] == "to" && !matches!(w[1], "the" | "his" | "her" | "their" | "one"));
+    if purpose {
+        return None;
+    }
+    let side = words.iter().find_map(|w| Side::of_word(w));
+    let forward = has(&["forward", "forwards", "front"]);
+    let backward = has(&["backward", "backwards", "back"]);
+    let shoulder = words
+        .windows(2)
+        .any(|w| matches!(w[1], "shoulder") && Side::of_word(w[0]).is_some());
+    if words.iter().any(|w| ELSEWHERE.contains(w)) {
+        return None;
+    }
+    let (lean, twist, name) = if has(LEANING) {
+        match (side, forward, backward) {
+            (Some(s), false, false) => (
+                lean_to(s),
+                Twist::None,
+                format!("leaning to the {}", s.name()),
+            ),
+            (None, true, false) => (Lean::Forward, Twist::None, "leaning forward".to_string()),
+            (None, false, true) => (Lean::Backward, Twist::None, "leaning backward".to_string()),
+            _ => return None,
+        }
+    } else if has(&["side"]) && has(&["bend", "bends", "stretch", "stretches"]) {
+        let s = side?;
+        (
+            lean_to(s),
+            Twist::None,
+            format!("leaning to the {}", s.name()),
+        )
+    } else if has(TURNING) && (shoulder || has(&["torso", "trunk", "waist", "body", "upper"])) {
+        let s = side?;
+        let twist = match s {
+            Side::Left => Twist::Left,
+            Side::Right => Twist::Right,
+        };
+        // Named as the words see it, so a reader of the plan knows the clause in it.
+        let name = if has(&["look", "looks", "looking", "glance", "glances", "glancing"]) {
+            format!("looking over the {} shoulder", s.name())
+        } else {
+            format!("torso turned to the {}", s.name())
+        };
+        (Lean::Upright, twist, name)
+    } else {
+        return None;
+    };
+    let script = PostureScript {
+        name: Some(name.clone()),
+        hold: HOLD_SECONDS,
+        constraints: vec![
+            Constraint::Level {
+                is: PelvisLevel::Standing,
+            },
+            Constraint::Lean { is: lean },
+            Constraint::Twist { is: twist },
+        ],
+    }
+    .check()
+    .ok()?;
+    Some(NamedPosture {
+        name,
+        synonyms: Vec::new(),
+        parts: BodyPart::ALL.to_vec(),
+        script,
+    })
+}
+
+fn lean_to(side: Side) -> Lean {
+    match side {
+        Side::Left => Lean::Left,
+        Side::Right => Lean::Right,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::posture::solver::solve;
+
+    fn pose(text: &str) -> Option<NamedPosture> {
+        torso_pose(&text.split(' ').collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn the_trunk_leans_or_turns_the_way_the_words_say_and_the_solver_meets_it() {
+        for (text, name) in [
+            ("leans to the left", "leaning to the left"),
+            ("she leans to the right", "leaning to the right"),
+            (
+                "stretches into a side bend to the right",
+                "leaning to the right",
+            ),
+            ("leaning backward", "leaning backward"),
+            ("bends forward", "leaning forward"),
+            (
+                "looks over the right shoulder",
+                "looking over the right shoulder",
+            ),
+            (
+                "twists the upper body to the left",
+                "torso turned to the left",
+            ),
+        ] {
+            let p = pose(text).unwrap_or_else(|| panic!("{text}: no pose"));
+            assert_eq!(p.name, name, "{text}");
+            let solved = solve(&p.script, None);
+            assert!(solved.unmet.is_empty(), "{text}: {:?}", solved.unmet);
+        }
+    }
+
+    #[test]
+    fn other_movements_are_no_torso_pose() {
+        for text in [
+            "bends down to pick up a box",
+            "bends forward to touch his toes",
+            "stretches her left arm to the side",
+            "leans on the wall",
+            "looks to the right",
+            "turns his head to the left",
+            "walks forward",
+            "leans",
+        ] {
+            assert!(pose(text).is_none(), "{text}");
+        }
+    }
+}
