@@ -19,7 +19,6 @@ use crate::skeleton::{self, joint, Offsets, Pose, NUM_JOINTS};
 use std::ops::Range;
 
 pub mod check;
-pub mod layers;
 
 /// Floats per frame.
 pub const FEATURE_DIM: usize = 263;

@@ -9,6 +9,7 @@ pub mod evaluator;
 pub mod gelu;
 pub mod generate;
 pub mod guidance;
+pub mod layers;
 pub mod motion_model;
 pub mod prior;
 pub mod tokens;

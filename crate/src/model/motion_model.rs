@@ -4,8 +4,9 @@
 
 use super::edit::{part_text, PartText};
 use super::generate::{MotionTokens, SamplingOptions};
+use super::layers;
 use super::{Spam, SpamFiles, SpamLoadError};
-use crate::features::{features_to_joints, layers, Features, Normalizer};
+use crate::features::{features_to_joints, Features, Normalizer};
 use crate::skeleton::{BodyPart, Pose};
 use crate::text::minilm::{MiniLmError, SentenceEncoder};
 use crate::timing::{FRAMES_PER_TOKEN, MAX_FRAMES};
@@ -245,7 +246,7 @@ impl MotionModel {
 
     /// The features (not normalised, 20 fps) of tokens: their decoding, or, where body-part
     /// clips lie on them as layers, the base motion with the clips' parts laid over their
-    /// spans (see [`crate::features::layers`]).
+    /// spans (see [`crate::model::layers`]).
     pub async fn features(&self, tokens: &MotionTokens) -> Features {
         self.features_and_base(tokens).await.0
     }

@@ -11,7 +11,7 @@
 //! MotionBuilder or Maya: the tokens are the final ones (clips laid), and beside them a sparse
 //! list of [`BasePatch`]es keeps the base motion's codes of each part over the steps a clip
 //! overwrote. The engine decodes the base everywhere and takes the clip's parts from the final
-//! tokens over the clip's span only (see [`crate::features::layers`]), so a clip moved or
+//! tokens over the clip's span only (see [`crate::model::layers`]), so a clip moved or
 //! deleted leaves the motion outside its spans exactly as it was. Tokens without patches are a
 //! motion of one layer, decoded as they are.
 

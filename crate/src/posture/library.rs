@@ -512,7 +512,8 @@ impl Library {
     }
 }
 
-/// Lower case, letters and digits kept, everything else one space: "T-Pose!" → "t pose".
+/// Lower case, letters and digits kept, everything else one space, possessives as "the":
+/// "T-Pose!" → "t pose", "on his knees" → "on the knees".
 fn normalise(text: &str) -> String {
     normalise_with_map(text).0
 }
@@ -542,7 +543,25 @@ fn normalise_with_map(text: &str) -> (String, Vec<usize>) {
         out.pop();
         map.pop();
     }
-    (out, map)
+    // "on his right knee" is "on the right knee": a possessive says whose body, never which
+    // posture, so one synonym serves every subject.
+    let mut plain = String::with_capacity(out.len());
+    let mut plain_map = Vec::with_capacity(map.len());
+    let mut at = 0;
+    for (n, word) in out.split(' ').enumerate() {
+        if n > 0 {
+            plain.push(' ');
+            plain_map.push(map[at - 1]);
+        }
+        let said = match word {
+            "his" | "her" | "their" | "its" => "the",
+            w => w,
+        };
+        plain.push_str(said);
+        plain_map.extend_from_slice(&map[at..at + said.len()]);
+        at += word.len() + 1;
+    }
+    (plain, plain_map)
 }
 
 #[cfg(test)]
@@ -569,6 +588,17 @@ mod tests {
         let (range, _) = &library.mentions(text)[1];
         assert_eq!(&text[range.clone()], "T-pose");
         assert!(library.mentions("he squatted").is_empty() || library.get("squatted").is_some());
+        // A possessive names whose body, not which posture; the range is still the text's own.
+        let text = "A man kneels on his right knee.";
+        let found = library.mentions(text);
+        assert_eq!(found.len(), 1);
+        assert_eq!(found[0].1.name(), "kneel on one knee");
+        assert_eq!(&text[found[0].0.clone()], "kneels on his right knee");
+        let text = "she drops to their knees";
+        assert_eq!(
+            &text[library.mentions(text)[0].0.clone()],
+            "drops to their knees"
+        );
     }
 
     #[test]

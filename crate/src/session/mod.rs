@@ -26,11 +26,12 @@ use crate::agents::pipeline::{self, RunOptions};
 use crate::agents::reviewer::Scorer;
 use crate::dataset::Vocabulary;
 use crate::features::{
-    features_to_joints, layers, reference_fit, with_reference_bones, with_reference_bones_fitted,
+    features_to_joints, reference_fit, with_reference_bones, with_reference_bones_fitted,
     FeatureFrame, Features, VELOCITIES,
 };
 use crate::feet::plant_feet;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
+use crate::model::layers;
 use crate::model::motion_model::sampling;
 use crate::model::tokens::MotionTokens;
 use crate::model::MotionModel;
@@ -329,7 +330,7 @@ impl Session {
     /// not be met in full.
     ///
     /// Body-part clips laid as layers on the tokens are composed over the base motion
-    /// ([`crate::features::layers`]) where the tokens turn into features, and once more at
+    /// ([`crate::model::layers`]) where the tokens turn into features, and once more at
     /// the end: the base motion is finished on its own (skeleton, key postures, planted feet)
     /// and the clips' parts are taken over their spans from the motion finished with them.
     /// Fitting the skeleton, laying key poses and planting the feet read the whole motion (a

@@ -337,7 +337,13 @@ fn punch_side(next: &[&str], prev: &[&str]) -> Option<Side> {
     if let Some(s) = prev.first().and_then(|w| side(w)) {
         return Some(s);
     }
-    let near: Vec<&str> = next.iter().take(4).copied().collect();
+    // "punches quickly with the right fist": a manner word says how, not with what.
+    let near: Vec<&str> = next
+        .iter()
+        .filter(|w| !w.ends_with("ly"))
+        .take(4)
+        .copied()
+        .collect();
     let hand = near.iter().any(|w| matches!(*w, "hand" | "fist" | "arm"));
     let sides: Vec<Side> = near.iter().filter_map(|w| side(w)).collect();
     match sides.as_slice() {
@@ -828,6 +834,18 @@ pub fn count_before(words: &[&str], at: usize) -> Option<usize> {
     }
     let n = number(before.last()?)?;
     (n >= 1.0).then(|| n.round().min(100.0) as usize)
+}
+
+/// A count between a verb at `at` and its plural object ("throws **two** punches", "does
+/// **three** kicks"); not a measure ("walks two metres", "takes two steps").
+pub fn count_after(words: &[&str], at: usize) -> Option<usize> {
+    let n = number(words.get(at + 1)?)?;
+    let noun = words.get(at + 2)?;
+    let measure = matches!(
+        *noun,
+        "times" | "metres" | "meters" | "feet" | "yards" | "steps" | "seconds" | "secs" | "minutes"
+    );
+    (n >= 2.0 && noun.ends_with('s') && !measure).then(|| n.round().min(100.0) as usize)
 }
 
 /// Gestures that name no side but mean both arms.

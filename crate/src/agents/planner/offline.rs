@@ -170,13 +170,16 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                     style.as_deref(),
                 ),
             };
-            if let Some(pose) = model
-                .is_none()
-                .then(|| torso_poses::torso_pose(words))
-                .flatten()
-            {
-                // "leans to the left": the standing body with its trunk held so.
-                let track = PostureTrack::holding(pose.parts, pose.script);
+            // "steps forward with the left foot", "leans to the left": key poses of the
+            // whole body the rules write themselves.
+            let own_track = super::sided::single_step(words).or_else(|| {
+                model
+                    .is_none()
+                    .then(|| torso_poses::torso_pose(words))
+                    .flatten()
+                    .map(|pose| PostureTrack::holding(pose.parts, pose.script))
+            });
+            if let Some(track) = own_track {
                 segments.push(Segment {
                     text: format!("a person {}", lexicon::without_subject(words).join(" ")),
                     seconds: clamp_seconds(track.natural_seconds() + DEFAULT_TRANSITION_SECONDS)
@@ -189,6 +192,14 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 });
                 previous = None;
                 ends_standing = None;
+                break 'clause;
+            }
+            if let Some(held) = segments
+                .last()
+                .filter(|last| postures::holds_by_name(words, last))
+                .and_then(|last| postures::hold_segment(words, last))
+            {
+                segments.push(held);
                 break 'clause;
             }
             let model_parts = model.as_ref().map(|m| (m.base, m.gestures.as_slice()));
@@ -727,14 +738,19 @@ impl Reader<'_> {
 /// [`MAX_SEGMENTS`] (with a note when more were asked).
 fn repetitions(words: &[&str], found: &Movements, notes: &mut Vec<String>) -> usize {
     let said = lexicon::repetitions(words);
-    if found.base.label().is_none() {
-        return said;
-    }
+    let dataset = found.base.label().is_some();
     let asked = if said > 1 {
         said
     } else {
-        lexicon::count_before(words, found.at).unwrap_or(1)
+        // "does three squats", "throws two punches", "does squats three times".
+        lexicon::count_before(words, found.at)
+            .filter(|n| dataset || *n > 1)
+            .or_else(|| lexicon::count_after(words, found.at))
+            .unwrap_or(1)
     };
+    if !dataset && said > 1 {
+        return said;
+    }
     if asked > MAX_SEGMENTS {
         notes.push(format!(
             "\"{}\" asks for {asked}; a plan has at most {MAX_SEGMENTS} segments, so it makes \

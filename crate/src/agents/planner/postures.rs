@@ -223,7 +223,14 @@ fn names_other_limb(after: &str, one_word: bool, named: &Named) -> bool {
 /// The one arm the words right after a mention name ("… with the left hand"), if they name
 /// one arm.
 fn one_arm_after(after: &str) -> Option<BodyPart> {
-    let next: Vec<&str> = after.split(' ').filter(|w| !w.is_empty()).take(4).collect();
+    // "points up at the sky with the left hand": a place may come between, not another
+    // movement.
+    let next: Vec<&str> = after
+        .split(' ')
+        .filter(|w| !w.is_empty())
+        .take_while(|w| !matches!(*w, "and" | "while" | "then" | "as"))
+        .take(8)
+        .collect();
     let arm = next.iter().any(|w| matches!(*w, "arm" | "hand" | "fist"));
     match (arm, next.contains(&"left"), next.contains(&"right")) {
         (true, true, false) => Some(BodyPart::LeftArm),
@@ -442,6 +449,31 @@ pub fn stay(words: &[&str]) -> Option<Stay> {
     }
 }
 
+/// Whether a clause holds by name the posture `previous` ends in ("lunges with the left leg,
+/// holds the lunge"): the same pose held on, not the library's posture made anew (which
+/// would forget the leg the clause before named).
+pub fn holds_by_name(words: &[&str], previous: &Segment) -> bool {
+    let Some(name) = previous
+        .postures
+        .as_ref()
+        .filter(|t| t.whole_body())
+        .and_then(|t| t.keys.last())
+        .and_then(|k| k.script.name.as_deref())
+    else {
+        return false;
+    };
+    let name_words: Vec<&str> = name.split([' ', ',']).collect();
+    words.windows(3).any(|w| {
+        matches!(
+            w[0],
+            "hold" | "holds" | "holding" | "keeps" | "keep" | "stays" | "stay"
+        ) && matches!(
+            w[1],
+            "the" | "that" | "this" | "his" | "her" | "their" | "in"
+        ) && name_words.contains(&w[2])
+    })
+}
+
 /// A segment that holds the last key pose of `previous` (a posture segment) for a while.
 pub fn hold_segment(words: &[&str], previous: &Segment) -> Option<Segment> {
     let track = previous.postures.as_ref().filter(|t| t.whole_body())?;
@@ -635,18 +667,22 @@ pub fn plan_clause(
         .collect();
     // So do the poses a movement of dataset v2 passes through ("crouches down into a squat").
     let passed = dataset_base.map_or(&[][..], library_names);
+    // "jogs in place": the model's jog travels, the library's stays on the spot.
+    let travels = model.is_some_and(|(base, _)| base.is_locomotion());
+    let on_the_spot =
+        |phrase: &str| travels && (phrase.contains("in place") || phrase.contains("on the spot"));
     mentions.retain(|(range, named)| {
         let phrase = &text[range.clone()];
         let plain_raise = phrase.split(' ').all(|w| PLAIN_GESTURE_WORDS.contains(&w));
         !plain_raise
-            && !phrase.split(' ').any(|w| model_words.contains(&w))
+            && (!phrase.split(' ').any(|w| model_words.contains(&w)) || on_the_spot(phrase))
             && !passed.contains(&named.name())
             && !names_other_limb(&text[range.end..], !phrase.contains(' '), named)
     });
     if mentions.is_empty() {
         return None;
     }
-    let named = named_words(words, &mentions);
+    let mut named = named_words(words, &mentions);
     let mut notes = Vec::new();
     // A one-arm posture goes on the arm the clause names ("points … with his left arm" is
     // the library's right-arm pointing, mirrored).
@@ -696,7 +732,6 @@ pub fn plan_clause(
 
     // A walk or a run keeps its legs: a posture of the whole body named beside it lends it
     // only its arms ("shuffles backward, keeping his guard up" walks in a boxer's guard).
-    let travels = model.is_some_and(|(base, _)| base.is_locomotion());
     let lent: Vec<NamedPosture> = body_postures
         .iter()
         .filter(|_| travels && action.is_none())
@@ -716,7 +751,15 @@ pub fn plan_clause(
             segment.parts.set(*part, None);
         }
         segment.text = format!("{} holding {}", segment.text, describe_names(&arm_postures));
-        segment.postures = Some(PostureTrack::holding(parts, arms));
+        let mut track = PostureTrack::holding(parts, arms);
+        // "claps her hands four times while walking": the count is the arms' when it follows
+        // their posture's own words (in "does two squats in a T-pose" it is the squats').
+        let arm_count = posture_count(&text, &mentions, arms_only);
+        if arm_count > 1 {
+            track.repeat = arm_count as u32;
+            track.returns = true;
+        }
+        segment.postures = Some(track);
         return Some(PostureClause {
             segment,
             notes,
@@ -729,6 +772,12 @@ pub fn plan_clause(
     let mut track = match &action {
         Some((_, a)) => {
             let mut track = a.track(count, direction(words));
+            // "hops forward on the right foot": a jump, on that foot.
+            let jumps = track.keys.iter().any(|k| k.jump_m.is_some());
+            if let Some(foot) = super::sided::hopping_foot(words).filter(|_| jumps) {
+                super::sided::on_one_foot(&mut track, foot);
+                named.extend(super::sided::leg_words(words));
+            }
             // The library turns to the left; "spins to the right" turns the other way.
             if turns_right(words) {
                 for key in &mut track.keys {
@@ -785,8 +834,10 @@ pub fn plan_clause(
                 BodyPart::ALL.to_vec()
             };
             let mut track = PostureTrack::holding(parts, script);
-            if let Some(n) = count.filter(|n| *n > 1) {
-                track.repeat = n;
+            // "raises the left arm twice while standing on one leg" stands on it once.
+            let n = posture_count(&text, &mentions, |_| true);
+            if n > 1 {
+                track.repeat = n as u32;
                 track.returns = true;
             }
             track
@@ -943,6 +994,25 @@ fn repetitions(words: &[&str], text: &str, action_at: Option<usize>) -> Option<u
     let at = action_at?;
     let before = text[..at].split(' ').rev().find(|w| !w.is_empty())?;
     lexicon::number(before).map(|n| n.round().clamp(1.0, 10.0) as u32)
+}
+
+/// How many times the clause counts a posture it names (of those `which` keeps): a count in
+/// the few words right after the posture's own words ("claps her hands four times", "squats
+/// twice"); 1 when none follows any.
+fn posture_count(
+    text: &str,
+    mentions: &[(std::ops::Range<usize>, Named<'_>)],
+    which: impl Fn(&NamedPosture) -> bool,
+) -> usize {
+    mentions
+        .iter()
+        .filter(|(_, n)| matches!(n, Named::Posture(p) if which(p)))
+        .map(|(r, _)| {
+            let after: Vec<&str> = text[r.end..].split_whitespace().take(4).collect();
+            lexicon::repetitions(&after)
+        })
+        .max()
+        .unwrap_or(1)
 }
 
 /// The way a movement travels, `[left, forward]`: forward unless the clause says otherwise,

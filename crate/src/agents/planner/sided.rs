@@ -3,11 +3,13 @@
 //! forward **with the right leg**", "lifts **the right knee**". The library writes each such
 //! posture for one side; which side is read from its own constraints (the knee on the ground,
 //! the foot off it, the foot in front), and the posture is mirrored when the words ask for
-//! the other.
+//! the other. A hop "on the right foot" is the library's jump on that foot, the other lifted;
+//! a step "with the left foot" is one step of that foot.
 
-use crate::posecodes::{BodyPoint, Relation, Support};
+use crate::posecodes::{Bend, BodyPoint, Distance, PelvisLevel, Relation, Support};
 use crate::posture::library::NamedPosture;
-use crate::posture::script::{Constraint, PostureScript};
+use crate::posture::script::{Constraint, Hinge, PostureScript};
+use crate::posture::track::PostureTrack;
 use crate::skeleton::{BodyPart, Side};
 
 /// The leg a one-legged posture does not rest on: the front leg of a kneel, the lifted leg
@@ -66,6 +68,23 @@ fn named_leg(words: &[&str]) -> Option<(Side, bool, &'static str)> {
     })
 }
 
+/// The indices of the words that name the leg ("on **the right foot**", "with **his left
+/// leg**"): the side word through the noun; empty when no leg is named.
+pub fn leg_words(words: &[&str]) -> std::ops::Range<usize> {
+    let noun = words
+        .iter()
+        .position(|w| matches!(*w, "leg" | "foot" | "knee"));
+    let side = noun.and_then(|n| {
+        (n.saturating_sub(3)..n)
+            .rev()
+            .find(|&k| Side::of_word(words[k]).is_some())
+    });
+    match (side, noun) {
+        (Some(s), Some(n)) => s..n + 1,
+        _ => 0..0,
+    }
+}
+
 /// `posture` on the leg `words` name: mirrored when the library's is the other, and named
 /// for that leg ("kneel on one knee, on the left knee"); itself when it is no one-legged
 /// posture of the whole body or the words name no leg.
@@ -96,6 +115,123 @@ pub fn on_leg(posture: &NamedPosture, words: &[&str]) -> NamedPosture {
         parts: posture.parts.clone(),
         script,
     }
+}
+
+/// The foot a clause hops on ("hops forward on the right foot", "hops on the left leg");
+/// `None` unless it hops on one foot it names.
+pub fn hopping_foot(words: &[&str]) -> Option<Side> {
+    let hops = words
+        .iter()
+        .any(|w| matches!(*w, "hop" | "hops" | "hopping" | "hopped"));
+    let (side, rests, _) = named_leg(words)?;
+    (hops && rests).then_some(side)
+}
+
+/// A jump's key poses made on the `stands_on` foot: the other foot off the ground with its
+/// knee bent throughout (take-off, flight, landing), each key named "hopping on the … foot".
+pub fn on_one_foot(track: &mut PostureTrack, stands_on: Side) {
+    let (free_foot, free_knee, free_point, stance_foot) = match stands_on {
+        Side::Left => (
+            Support::RightFoot,
+            Hinge::RightKnee,
+            BodyPoint::RightFoot,
+            Support::LeftFoot,
+        ),
+        Side::Right => (
+            Support::LeftFoot,
+            Hinge::LeftKnee,
+            BodyPoint::LeftFoot,
+            Support::RightFoot,
+        ),
+    };
+    let name = format!("hopping on the {} foot", stands_on.name());
+    for key in &mut track.keys {
+        // What the two-footed jump asked of the free leg (on the ground, feet apart) goes.
+        key.script.constraints.retain(|c| match c {
+            Constraint::Contact { point, .. } => *point != free_foot && *point != stance_foot,
+            Constraint::Bend { joint, .. } => *joint != free_knee,
+            Constraint::Distance { a, b, .. } => *a != free_point && *b != free_point,
+            _ => true,
+        });
+        key.script.constraints.extend([
+            Constraint::Contact {
+                point: free_foot,
+                on_ground: false,
+            },
+            Constraint::Contact {
+                point: stance_foot,
+                on_ground: true,
+            },
+            Constraint::Bend {
+                joint: free_knee,
+                is: Bend::PartiallyBent,
+            },
+        ]);
+        key.script.name = Some(name.clone());
+    }
+}
+
+/// How far one step carries the body, metres (about half an adult's stride).
+const STEP_METRES: f64 = 0.35;
+
+/// One step of the foot a clause names ("steps forward with the left foot", "steps back with
+/// the right foot"): the body carried [`STEP_METRES`] that way and standing with that foot
+/// ahead (or behind), both feet on the ground. `None` unless the clause steps with a foot it
+/// names, forward or back.
+pub fn single_step(words: &[&str]) -> Option<PostureTrack> {
+    let steps = words
+        .iter()
+        .any(|w| matches!(*w, "step" | "steps" | "stepping"));
+    let (side, rests, _) = named_leg(words)?;
+    let has = |list: &[&str]| words.iter().any(|w| list.contains(w));
+    let forward = has(&["forward", "forwards", "ahead", "front"]);
+    let back = has(&["back", "backward", "backwards", "behind"]);
+    if !steps || rests || forward == back {
+        return None;
+    }
+    let (foot, way, sign) = match (side, forward) {
+        (Side::Left, true) => (BodyPoint::LeftFoot, "forward", 1.0),
+        (Side::Right, true) => (BodyPoint::RightFoot, "forward", 1.0),
+        (Side::Left, false) => (BodyPoint::LeftFoot, "back", -1.0),
+        (Side::Right, false) => (BodyPoint::RightFoot, "back", -1.0),
+    };
+    let name = format!("step {way} with the {} foot", side.name());
+    let script = PostureScript {
+        name: Some(name),
+        hold: 0.5,
+        constraints: vec![
+            Constraint::Level {
+                is: PelvisLevel::Standing,
+            },
+            Constraint::Contact {
+                point: Support::LeftFoot,
+                on_ground: true,
+            },
+            Constraint::Contact {
+                point: Support::RightFoot,
+                on_ground: true,
+            },
+            Constraint::Relation {
+                a: foot,
+                b: BodyPoint::Pelvis,
+                is: if forward {
+                    Relation::InFrontOf
+                } else {
+                    Relation::Behind
+                },
+            },
+            Constraint::Distance {
+                a: BodyPoint::LeftFoot,
+                b: BodyPoint::RightFoot,
+                is: Distance::ShoulderWidth,
+            },
+        ],
+    }
+    .check()
+    .ok()?;
+    let mut track = PostureTrack::holding(crate::skeleton::BodyPart::ALL.to_vec(), script);
+    track.keys[0].travel = [0.0, sign * STEP_METRES];
+    Some(track)
 }
 
 #[cfg(test)]
@@ -146,5 +282,62 @@ mod tests {
         assert_eq!(on_leg(&kneel, &words("kneels down")), kneel);
         let squat = named("squat");
         assert_eq!(on_leg(&squat, &words("squats on the left leg")), squat);
+    }
+
+    #[test]
+    fn a_step_is_one_step_of_the_foot_named() {
+        use crate::posture::solver::solve;
+        let track = single_step(&words("steps forward with the left foot")).expect("a step");
+        let key = &track.keys[0];
+        assert_eq!(
+            key.script.name.as_deref(),
+            Some("step forward with the left foot")
+        );
+        assert_eq!(key.travel, [0.0, STEP_METRES]);
+        assert!(solve(&key.script, None).unmet.is_empty());
+        let back = single_step(&words("steps back with the right foot")).expect("a step");
+        assert_eq!(back.keys[0].travel, [0.0, -STEP_METRES]);
+        assert!(solve(&back.keys[0].script, None).unmet.is_empty());
+        for text in [
+            "steps forward",
+            "steps on the left foot",
+            "walks forward with the left foot",
+        ] {
+            assert!(single_step(&words(text)).is_none(), "{text}");
+        }
+    }
+
+    #[test]
+    fn a_hop_on_one_foot_lifts_the_other_and_the_solver_meets_it() {
+        use crate::posture::solver::solve;
+        assert_eq!(
+            hopping_foot(&words("hops forward on the right foot")),
+            Some(Side::Right)
+        );
+        assert_eq!(
+            hopping_foot(&words("hops on his left leg")),
+            Some(Side::Left)
+        );
+        assert_eq!(hopping_foot(&words("hops forward")), None);
+        assert_eq!(leg_words(&words("hops forward on the right foot")), 4..6);
+        assert_eq!(hopping_foot(&words("jumps on the left foot")), None);
+        let jump = Library::builtin()
+            .all()
+            .find_map(|n| match n {
+                crate::posture::library::Named::Action(a) if a.name == "jump" => Some(a),
+                _ => None,
+            })
+            .expect("the library has a jump");
+        let mut track = jump.track(None, [0.0, 1.0]);
+        on_one_foot(&mut track, Side::Right);
+        for key in &track.keys {
+            assert_eq!(
+                key.script.name.as_deref(),
+                Some("hopping on the right foot")
+            );
+            assert_eq!(free_leg(&key.script), Some(Side::Left));
+            let solved = solve(&key.script, None);
+            assert!(solved.unmet.is_empty(), "{:?}", solved.unmet);
+        }
     }
 }

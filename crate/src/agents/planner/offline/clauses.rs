@@ -203,12 +203,21 @@ fn with_gaps_filled(clauses: Vec<Vec<String>>, known: Repertoire) -> Vec<Vec<Str
                 )
             })
             .count();
-        let gapped = clause.first().is_some_and(|w| WAYS.contains(&w.as_str()))
+        // "hops on the right foot, then on the left foot": a side given by "on".
+        let on_a_side = clause.first().is_some_and(|w| w == "on")
+            && clause
+                .iter()
+                .take(3)
+                .any(|w| crate::skeleton::Side::of_word(w).is_some());
+        let opener = clause.first().map(String::as_str).unwrap_or("");
+        let gapped = (WAYS.contains(&opener) || on_a_side)
             && !clause[..own].iter().any(|w| is_verb(w, known));
         let head = out.last().filter(|_| gapped).and_then(|before| {
             let verb = before.iter().position(|w| is_verb(w, known))?;
             let way = (verb + 1..before.len())
-                .find(|&i| WAYS.contains(&before[i].as_str()) || before[i] == ",")
+                .find(|&i| {
+                    WAYS.contains(&before[i].as_str()) || before[i] == "," || before[i] == opener
+                })
                 .unwrap_or(before.len());
             Some(before[verb..way].to_vec())
         });

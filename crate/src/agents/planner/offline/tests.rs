@@ -681,9 +681,14 @@ const PLANNED_BEFORE_V2: &[(&str, &[Recorded])] = &[
         "a person walks stealthily",
         &[("a person walks forward", &[])],
     ),
+    // Counted since: three kicks are three kicks whichever model makes them.
     (
         "a person does 3 kicks",
-        &[("a person kicks forward with a leg", &[])],
+        &[
+            ("a person kicks forward with a leg", &[]),
+            ("a person kicks forward with a leg", &[]),
+            ("a person kicks forward with a leg", &[]),
+        ],
     ),
 ];
 
@@ -922,6 +927,13 @@ fn a_clause_without_its_verb_takes_the_verb_before() {
             "walks forward with both hands on the head"
         ]
     );
+    assert_eq!(
+        texts("a person hops on the right foot four times, then on the left foot four times"),
+        [
+            "a person hops on the right foot four times",
+            "hops on the left foot four times"
+        ]
+    );
     // A clause with its own verb keeps it; one with nothing before stays as it is.
     assert_eq!(
         texts("she jumps forward, then walks back"),
@@ -1032,4 +1044,81 @@ fn the_other_one_holds_the_place_before_on_the_other_side() {
         "{plan:#?}"
     );
     assert!(plan.clips[1].start >= plan.clips[0].end - 1e-9);
+}
+
+/// The names of the key poses a segment's track holds, in order, each once.
+fn key_names(segment: &Segment) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for key in segment.postures.iter().flat_map(|t| &t.keys) {
+        let name = key.script.name.clone().unwrap_or_default();
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    names
+}
+
+#[test]
+fn sides_and_counts_said_in_passing_are_kept() {
+    // The knee named with a possessive is still one knee, the right one.
+    let kneel = plan("A man kneels on his right knee and bows his head.", None);
+    assert_eq!(
+        key_names(&kneel.segments[0]),
+        ["kneel on one knee, on the right knee"],
+        "{kneel:#?}"
+    );
+    // "holds the lunge" holds the lunge the clause before made, on its leg.
+    let lunge = plan(
+        "A man lunges forward with the left leg, holds the lunge, then returns to standing.",
+        None,
+    );
+    assert_eq!(key_names(&lunge.segments[1]), ["lunge with the left leg"]);
+    // A hop on one foot, a step with one foot.
+    let hop = plan("A girl hops forward on the right foot.", None);
+    assert_eq!(key_names(&hop.segments[0]), ["hopping on the right foot"]);
+    let steps = plan(
+        "A man steps forward with the left foot, then steps back with the right foot.",
+        None,
+    );
+    assert_eq!(
+        steps
+            .segments
+            .iter()
+            .flat_map(key_names)
+            .collect::<Vec<_>>(),
+        [
+            "step forward with the left foot",
+            "step back with the right foot"
+        ]
+    );
+    // In place, the library's jog; the model's would run off.
+    let jog = plan("A woman jogs in place.", None);
+    assert_eq!(
+        key_names(&jog.segments[0]),
+        [
+            "jogging in place, left knee up",
+            "jogging in place, right knee up"
+        ],
+        "{jog:#?}"
+    );
+    // A count between the verb and its object; a count after an arm posture over a walk.
+    let punches = plan("A boxer throws two punches with the left hand.", None);
+    assert_eq!(bases(&punches), ["a person throws a left punch"; 2]);
+    let claps = plan(
+        "A woman claps her hands four times while walking forward.",
+        None,
+    );
+    let track = claps.segments[0]
+        .postures
+        .as_ref()
+        .expect("the clap is held");
+    assert_eq!(track.repeat, 4, "{claps:#?}");
+    assert_eq!(claps.segments[0].base, "a person walks forward");
+    // "with the left hand" names the arm even with a place between.
+    let point = plan("A child points up at the sky with the left hand.", None);
+    let track = point.segments[0]
+        .postures
+        .as_ref()
+        .expect("a pointing posture");
+    assert_eq!(track.parts, [BodyPart::LeftArm], "{point:#?}");
 }

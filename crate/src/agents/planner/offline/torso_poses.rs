@@ -20,11 +20,16 @@ const LEANING: &[&str] = &[
     "sways", "swaying",
 ];
 
-/// Verbs of a turn of the trunk, or of a look that turns it ("looks over the right
-/// shoulder").
+/// Verbs of a turn of the trunk.
 const TURNING: &[&str] = &[
-    "twist", "twists", "twisting", "rotate", "rotates", "rotating", "look", "looks", "looking",
-    "glance", "glances", "glancing",
+    "twist", "twists", "twisting", "rotate", "rotates", "rotating",
+];
+
+/// Verbs of a look, which turns the upper body toward where the eyes go: the skeleton's head
+/// is one joint, so a look is seen by the shoulders turning ("looks over the right shoulder",
+/// "looks to the left").
+const LOOKING: &[&str] = &[
+    "look", "looks", "looking", "glance", "glances", "glancing", "peek", "peeks", "peeking",
 ];
 
 /// Words that say the whole trunk goes, not a limb: "bends **down** to pick up" is a
@@ -51,7 +56,12 @@ pub(super) fn torso_pose(words: &[&str]) -> Option<NamedPosture> {
     let shoulder = words
         .windows(2)
         .any(|w| matches!(w[1], "shoulder") && Side::of_word(w[0]).is_some());
-    if words.iter().any(|w| ELSEWHERE.contains(w)) {
+    // "turns his head to the left": the head's turn, seen as a look is.
+    let head_turn = has(&["turn", "turns", "turning"]) && has(&["head"]);
+    if words
+        .iter()
+        .any(|w| ELSEWHERE.contains(w) && !(head_turn && *w == "head"))
+    {
         return None;
     }
     let (lean, twist, name) = if has(LEANING) {
@@ -72,15 +82,31 @@ pub(super) fn torso_pose(words: &[&str]) -> Option<NamedPosture> {
             Twist::None,
             format!("leaning to the {}", s.name()),
         )
-    } else if has(TURNING) && (shoulder || has(&["torso", "trunk", "waist", "body", "upper"])) {
-        let s = side?;
+    } else if has(TURNING) || has(LOOKING) || head_turn {
+        let trunk = shoulder || has(&["torso", "trunk", "waist", "body", "upper"]);
+        if has(TURNING) && !trunk {
+            return None;
+        }
+        // "looks to the left" goes that way; "looks at the left door" names a thing.
+        let s = if trunk {
+            side?
+        } else {
+            words
+                .windows(3)
+                .find(|w| matches!(w[0], "to" | "toward" | "towards") && w[1] == "the")
+                .and_then(|w| Side::of_word(w[2]))?
+        };
         let twist = match s {
             Side::Left => Twist::Left,
             Side::Right => Twist::Right,
         };
         // Named as the words see it, so a reader of the plan knows the clause in it.
-        let name = if has(&["look", "looks", "looking", "glance", "glances", "glancing"]) {
+        let name = if head_turn {
+            format!("head turned to the {}", s.name())
+        } else if has(LOOKING) && shoulder {
             format!("looking over the {} shoulder", s.name())
+        } else if has(LOOKING) {
+            format!("looking to the {}", s.name())
         } else {
             format!("torso turned to the {}", s.name())
         };
@@ -140,6 +166,8 @@ mod tests {
                 "looks over the right shoulder",
                 "looking over the right shoulder",
             ),
+            ("looks to the right", "looking to the right"),
+            ("turns his head to the left", "head turned to the left"),
             (
                 "twists the upper body to the left",
                 "torso turned to the left",
@@ -158,9 +186,10 @@ mod tests {
             "bends down to pick up a box",
             "bends forward to touch his toes",
             "stretches her left arm to the side",
+            "looks at his left hand",
+            "looks up",
+            "twists his left wrist",
             "leans on the wall",
-            "looks to the right",
-            "turns his head to the left",
             "walks forward",
             "leans",
         ] {

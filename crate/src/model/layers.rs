@@ -24,10 +24,12 @@
 //! where the tokens move into and out of the clip), except at the motion's own first and last
 //! frame; outside every patch it is 0, and the base's numbers are kept bit for bit.
 
-use super::{FeatureFrame, Features, CONTACTS, POSITIONS, ROOT_HEIGHT, ROTATIONS, VELOCITIES};
+use super::edit::SEAM_STEPS;
+use super::tokens::{MotionTokens, PARTS};
+use crate::features::{
+    FeatureFrame, Features, CONTACTS, POSITIONS, ROOT_HEIGHT, ROTATIONS, VELOCITIES,
+};
 use crate::geom;
-use crate::model::edit::SEAM_STEPS;
-use crate::model::tokens::{MotionTokens, PARTS};
 use crate::skeleton::{joint, BodyPart, NUM_JOINTS};
 use crate::timing::FRAMES_PER_TOKEN;
 
