@@ -359,9 +359,8 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
     Some(match word {
         "walk" | "walks" | "walking" | "walked" | "stroll" | "strolls" | "strolling" | "march"
         | "marches" | "marching" | "shuffle" | "shuffles" | "shuffling" | "wander" | "wanders"
-        | "wandering" | "pace" | "paces" | "pacing" | "steps" | "stepping" => {
-            Action::Walk(Direction::Forward)
-        }
+        | "wandering" | "pace" | "paces" | "pacing" | "steps" | "stepping" | "sidestep"
+        | "sidesteps" | "sidestepping" => Action::Walk(Direction::Forward),
         // "walks forward, turning left" walks; "turns to the left" on its own is the key-pose
         // library's turn on the spot.
         "turning" => {
@@ -902,6 +901,12 @@ pub fn is_finite_verb(word: &str) -> bool {
         "rests",
         "finish",
         "finishes",
+        "end",
+        "ends",
+        "leave",
+        "leaves",
+        "exit",
+        "exits",
         "start",
         "starts",
         "begin",

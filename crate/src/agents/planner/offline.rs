@@ -308,12 +308,22 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                     anaphora::repeated(last, a)
                 })
             {
-                // "waves with the left hand, then with the right".
-                segments.push(once_more);
+                // "waves with the left hand, then with the right"; "repeats it twice more".
+                for _ in 0..lexicon::repetitions(words) {
+                    segments.push(once_more.clone());
+                }
                 break 'clause;
             }
-            if let Some(lowered) = model
-                .is_none()
+            // After a raise, "puts it back down" lowers the arm; after anything else (picking
+            // a box up) it is the model's putting down.
+            let after_raise = segments.last().is_some_and(|s| {
+                let said_raise = s
+                    .text
+                    .split(' ')
+                    .any(|w| matches!(w, "raise" | "raises" | "lift" | "lifts"));
+                said_raise && !anaphora::raised_arms(s).is_empty()
+            });
+            if let Some(lowered) = (model.is_none() || after_raise)
                 .then(|| lowered_back(words, segments.last()))
                 .flatten()
             {

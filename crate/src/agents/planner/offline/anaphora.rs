@@ -130,7 +130,8 @@ const FILLER: &[&str] = &[
     "with", "the", "his", "her", "their", "its", "then", "and", "one", "hand", "arm", "foot",
     "leg", "fist", "side", "too", "also", "now", "same", "on", "using", "a", "person", "he", "she",
     "they", "someone", "it", "again", "does", "do", "did", "repeats", "repeat", "same", "thing",
-    "once", "more", "over", "this", "time", "switches", "switch", "to",
+    "once", "more", "over", "this", "time", "switches", "switch", "to", "twice", "thrice", "times",
+    "two", "three", "four",
 ];
 
 /// Whether a clause only points back at the movement before ("does it again", "with the

@@ -232,6 +232,20 @@ fn with_gaps_filled(clauses: Vec<Vec<String>>, known: Repertoire) -> Vec<Vec<Str
     out
 }
 
+/// How many words after "after" say only a pause ("a moment", "a while", "a few seconds",
+/// "some time"); 0 when they name an event ("after the jump").
+fn pause_after(rest: &[String]) -> usize {
+    let word = |k: usize| rest.get(k).map(String::as_str).unwrap_or("");
+    const PAUSES: &[&str] = &[
+        "moment", "while", "pause", "second", "seconds", "beat", "bit", "moments", "time",
+    ];
+    match (word(0), word(1), word(2)) {
+        ("a", "few", w) if PAUSES.contains(&w) => 3,
+        ("a" | "some", w, _) if PAUSES.contains(&w) => 2,
+        _ => 0,
+    }
+}
+
 fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> {
     let mut chunks: Vec<Chunk> = vec![Chunk {
         words: Vec::new(),
@@ -312,6 +326,12 @@ fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> 
                     chunks.last_mut().unwrap().words.push(w.to_string());
                 }
                 i += 1;
+                continue;
+            }
+            // "and after a moment puts it back down": a pause, then what follows.
+            "after" if pause_after(rest) > 0 => {
+                new_chunk(&mut chunks, Marker::None, false);
+                i += 1 + pause_after(rest);
                 continue;
             }
             "after" if word(i + 1) == "that" || word(i + 1) == "this" => {

@@ -97,10 +97,13 @@ fn is_destination_word(word: &str) -> bool {
 }
 
 /// Verbs after "to" that are the movement itself ("crouches to set something down",
-/// "lowers the body to lie flat"), as the training captions say it, not a reason for it.
+/// "lowers the body to lie flat", "stops to wave with his right hand"), as the training
+/// captions say it, not a reason for it.
 const MOVEMENT_INFINITIVES: &[&str] = &[
     "lie", "lay", "set", "put", "place", "pick", "sit", "kneel", "squat", "crouch", "touch",
-    "reach", "bend", "lean", "step", "walk", "run", "jump", "turn", "spin", "look", "bow",
+    "reach", "bend", "lean", "step", "walk", "run", "jump", "turn", "spin", "look", "bow", "wave",
+    "clap", "point", "salute", "kick", "punch", "stretch", "dance", "throw", "catch", "raise",
+    "lift", "hop", "skip", "crawl", "climb", "nod",
 ];
 
 /// Limb nouns after "to": the body part a movement goes to ("elbow to knee").

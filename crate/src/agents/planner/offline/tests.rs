@@ -934,6 +934,11 @@ fn a_clause_without_its_verb_takes_the_verb_before() {
             "hops on the left foot four times"
         ]
     );
+    // "after a moment" is a pause, not an event the clause comes after.
+    assert_eq!(
+        texts("a man raises his left hand, and after a moment puts it back down"),
+        ["a man raises his left hand", "puts it back down"]
+    );
     // A clause with its own verb keeps it; one with nothing before stays as it is.
     assert_eq!(
         texts("she jumps forward, then walks back"),
@@ -1121,4 +1126,43 @@ fn sides_and_counts_said_in_passing_are_kept() {
         .as_ref()
         .expect("a pointing posture");
     assert_eq!(track.parts, [BodyPart::LeftArm], "{point:#?}");
+    // "repeats it twice more": two more.
+    let squats = plan("A man does a squat and repeats it twice more.", None);
+    assert_eq!(squats.segments.len(), 3, "{squats:#?}");
+}
+
+#[test]
+fn ending_leaving_and_sidestepping_are_movements_of_their_own() {
+    let ends = plan(
+        "The dancer jumps up with arms raised, and ends in a T-pose.",
+        None,
+    );
+    let last = ends.segments.last().expect("segments");
+    assert!(key_names(last).iter().any(|n| n == "T-pose"), "{ends:#?}");
+    assert!(ends.segments.len() >= 2, "{ends:#?}");
+    let leaves = plan("A man stands up, and leaves walking to the left.", None);
+    assert_eq!(
+        leaves.segments.last().map(|s| s.base.as_str()),
+        Some("a person walks to the left"),
+        "{leaves:#?}"
+    );
+    let side = plan(
+        "Someone sidesteps to the right with both arms crossed over the chest.",
+        None,
+    );
+    assert_eq!(
+        side.segments[0].base, "a person walks to the right",
+        "{side:#?}"
+    );
+    assert_eq!(key_names(&side.segments[0]), ["arms crossed"]);
+    // "puts it back down" after a raise lowers the arm, after a pick-up puts the thing down.
+    let lowered = plan(
+        "A man raises his left hand to wave, and after a moment puts it back down.",
+        None,
+    );
+    assert_eq!(
+        key_names(lowered.segments.last().expect("segments")),
+        [anaphora::ARMS_DOWN],
+        "{lowered:#?}"
+    );
 }

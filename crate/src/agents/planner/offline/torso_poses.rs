@@ -91,10 +91,17 @@ pub(super) fn torso_pose(words: &[&str]) -> Option<NamedPosture> {
         let s = if trunk {
             side?
         } else {
+            // "looks to the left", "looks left".
             words
                 .windows(3)
                 .find(|w| matches!(w[0], "to" | "toward" | "towards") && w[1] == "the")
-                .and_then(|w| Side::of_word(w[2]))?
+                .and_then(|w| Side::of_word(w[2]))
+                .or_else(|| {
+                    words
+                        .windows(2)
+                        .find(|w| LOOKING.contains(&w[0]))
+                        .and_then(|w| Side::of_word(w[1]))
+                })?
         };
         let twist = match s {
             Side::Left => Twist::Left,
@@ -167,6 +174,7 @@ mod tests {
                 "looking over the right shoulder",
             ),
             ("looks to the right", "looking to the right"),
+            ("glances left", "looking to the left"),
             ("turns his head to the left", "head turned to the left"),
             (
                 "twists the upper body to the left",
