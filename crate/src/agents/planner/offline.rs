@@ -606,6 +606,17 @@ fn standing_poses(words: &[&str]) -> Option<(Segment, Vec<NamedPosture>)> {
             poses.push(pose);
         }
     }
+    let touches = words.iter().any(|w| {
+        matches!(
+            *w,
+            "touches" | "touch" | "touching" | "presses" | "pressing" | "rests" | "resting"
+        )
+    });
+    if poses.is_empty() && touches {
+        // "touches the right knee with the left hand": the place comes before the limb that
+        // goes there, across the "with" that parts the phrases.
+        poses.extend(limb_poses::limb_pose(&lexicon::without_subject(words)));
+    }
     if poses.is_empty() {
         return None;
     }

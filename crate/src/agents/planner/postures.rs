@@ -673,6 +673,18 @@ pub fn plan_clause(
         |phrase: &str| travels && (phrase.contains("in place") || phrase.contains("on the spot"));
     mentions.retain(|(range, named)| {
         let phrase = &text[range.clone()];
+        // "puts the left hand on the right knee": where the hand goes, not a kneel.
+        let hand_goes = text[..range.start]
+            .split_whitespace()
+            .rev()
+            .take(3)
+            .any(|w| matches!(w, "hand" | "hands" | "palm" | "palms" | "fist" | "fingers"))
+            && ["on ", "onto ", "to ", "against "]
+                .iter()
+                .any(|p| phrase.starts_with(p));
+        if hand_goes {
+            return false;
+        }
         let plain_raise = phrase.split(' ').all(|w| PLAIN_GESTURE_WORDS.contains(&w));
         !plain_raise
             && (!phrase.split(' ').any(|w| model_words.contains(&w)) || on_the_spot(phrase))

@@ -173,6 +173,18 @@ pub(super) fn limbs_left_unplaced(
     let mut out = Vec::new();
     for (i, w) in words.iter().enumerate() {
         let Some(limb) = limb(w) else { continue };
+        // "touches the right knee", "on his left foot" after a hand: where a hand goes.
+        let touched = words[i.saturating_sub(3)..i].iter().any(|w| {
+            matches!(
+                *w,
+                "touches" | "touching" | "touch" | "on" | "onto" | "to" | "against" | "over"
+            )
+        }) && words
+            .iter()
+            .any(|w| matches!(*w, "hand" | "hands" | "fingers" | "palm"));
+        if touched && limb == "leg" {
+            continue;
+        }
         let side = words[i.saturating_sub(2)..i]
             .iter()
             .rev()

@@ -1165,4 +1165,15 @@ fn ending_leaving_and_sidestepping_are_movements_of_their_own() {
         [anaphora::ARMS_DOWN],
         "{lowered:#?}"
     );
+    // A hand put on a knee is a hand's place, whichever way the words order it.
+    for prompt in [
+        "A person touches the right knee with the left hand.",
+        "A person puts the left hand on the right knee.",
+    ] {
+        let touch = plan(prompt, None);
+        assert_eq!(touch.clips.len(), 1, "{prompt}: {touch:#?}");
+        assert_eq!(touch.clips[0].parts, [BodyPart::LeftArm]);
+        assert_eq!(touch.clips[0].text, "left hand on the right knee");
+        assert!(touch.notes.is_empty(), "{prompt}: {:?}", touch.notes);
+    }
 }
