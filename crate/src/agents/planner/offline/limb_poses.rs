@@ -121,6 +121,9 @@ enum Place {
     Behind,
     UpForward,
     UpOut,
+    /// Holding a thing in front of the body: the upper arm down, the forearm level, the hand
+    /// in front of the hip ("holding a cup in his right hand", "carrying a tray").
+    Holding,
     /// Touching a body point (the hand's own side where the point has sides and the words
     /// name none).
     On(Target),
@@ -178,6 +181,9 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
     {
         return None;
     }
+    if let Some(pose) = holding_pose(phrase) {
+        return Some(pose);
+    }
     let nouns: Vec<(usize, Kind, bool)> = phrase
         .iter()
         .enumerate()
@@ -213,6 +219,77 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
         Kind::Arm => arm_pose(scope, &sides),
         Kind::Leg => leg_pose(scope, at, &sides),
     }
+}
+
+/// The pose of a hand that holds a thing ("holding a cup in his right hand", "with a cane
+/// in her right hand", "carrying a tray on the left hand"): the hand the thing is in or on,
+/// held in front of the body. `None` when the phrase holds nothing in a hand it names.
+fn holding_pose(phrase: &[&str]) -> Option<NamedPosture> {
+    let holds = has(
+        phrase,
+        &[
+            "holding",
+            "holds",
+            "carrying",
+            "carries",
+            "clutching",
+            "clutches",
+            "gripping",
+            "grips",
+        ],
+    ) || matches!(phrase, ["with", "a" | "an", ..]);
+    // One limb only: "carrying a tray on the left hand, the right arm tucked behind the
+    // back" says the right arm's place.
+    if !holds || phrase.iter().filter(|w| limb_noun(w).is_some()).count() != 1 {
+        return None;
+    }
+    let at = phrase.iter().position(|w| matches!(*w, "hand" | "hands"))?;
+    let before = &phrase[at.saturating_sub(4)..at];
+    if !before.iter().any(|w| matches!(*w, "in" | "on")) {
+        return None;
+    }
+    let sides = if phrase[at] == "hands" || before.contains(&"both") {
+        vec![Side::Left, Side::Right]
+    } else {
+        vec![before.iter().rev().find_map(|w| Side::of_word(w))?]
+    };
+    let constraints = sides
+        .iter()
+        .flat_map(|s| arm_constraints(*s, Place::Holding))
+        .collect();
+    let hands = match sides.as_slice() {
+        [one] => format!("{} hand", one.name()),
+        _ => "both hands".to_string(),
+    };
+    // The thing held, as the words name it ("a cup", "a cane"), up to where the hand is.
+    let verb = phrase
+        .iter()
+        .position(|w| {
+            matches!(
+                *w,
+                "holding"
+                    | "holds"
+                    | "carrying"
+                    | "carries"
+                    | "clutching"
+                    | "clutches"
+                    | "gripping"
+                    | "grips"
+                    | "with"
+            )
+        })
+        .filter(|v| *v < at)?;
+    let until = (verb + 1..at)
+        .find(|&k| matches!(phrase[k], "in" | "on"))
+        .unwrap_or(at);
+    let thing = &phrase[verb + 1..until];
+    let thing = if thing.is_empty() || thing.len() > 4 {
+        "something".to_string()
+    } else {
+        thing.join(" ")
+    };
+    let parts = sides.iter().map(|s| arm_part(*s)).collect();
+    posture(format!("{hands} holding {thing}"), parts, constraints)
 }
 
 /// Words that open a limb's own words ("the right arm", "his left hand").
@@ -274,10 +351,14 @@ fn arm_place(phrase: &[&str]) -> Option<Place> {
     if let Some(t) = target(phrase) {
         return Some(Place::On(t));
     }
+    // "behind the back", and a hand "on his back" (its own back: behind the body).
     if phrase
         .windows(2)
         .any(|w| w[0] == "behind" && matches!(w[1], "the" | "his" | "her" | "their"))
         && has(phrase, &["back"])
+        || phrase.windows(3).any(|w| {
+            w[0] == "on" && matches!(w[1], "the" | "his" | "her" | "their") && w[2] == "back"
+        })
     {
         return Some(Place::Behind);
     }
@@ -406,6 +487,7 @@ fn arm_pose(phrase: &[&str], sides: &[Side]) -> Option<NamedPosture> {
             "{who} up and out to the side{}",
             if both { "s" } else { "" }
         ),
+        Place::Holding => format!("{hands} holding something"),
         Place::On(t) => {
             let on = match t {
                 Target::Hip(Some(s)) | Target::Knee(Some(s)) | Target::Shoulder(Some(s)) => {
@@ -511,6 +593,12 @@ fn arm_constraints(side: Side, place: Place) -> Vec<Constraint> {
             rel(elbow_point, shoulder, Relation::Above),
             rel(hand, BodyPoint::Head, Relation::Above),
             rel(hand, shoulder, outward(side)),
+        ],
+        Place::Holding => vec![
+            bend(Bend::PartiallyBent),
+            orient(upper, Orientation::Vertical),
+            orient(fore, Orientation::Horizontal),
+            rel(hand, hip, Relation::InFrontOf),
         ],
         Place::On(t) => {
             let point = |s: Option<Side>, left, right, own| match s {
@@ -765,6 +853,27 @@ mod tests {
             Some("right hand behind the back".into()),
             "the hand under the tray is no place of the right arm's"
         );
+        for (text, name) in [
+            (
+                "holding a cup in his right hand",
+                "right hand holding a cup",
+            ),
+            ("with a cane in her right hand", "right hand holding a cane"),
+            (
+                "carrying a tray on the right hand",
+                "right hand holding a tray",
+            ),
+        ] {
+            assert_eq!(
+                read(text),
+                Some((name.into(), vec![BodyPart::RightArm])),
+                "{text}"
+            );
+        }
+        assert_eq!(
+            read("with his right hand on his back").map(|p| p.0),
+            Some("right hand behind the back".into())
+        );
         assert_eq!(
             read("stands on the left leg").map(|p| p.0),
             Some("standing on the left leg".into())
@@ -802,6 +911,8 @@ mod tests {
             "lifts the left knee",
             "the left leg out to the side",
             "stands on the right leg",
+            "holding a cup in his right hand",
+            "carrying a box in both hands",
         ] {
             let words: Vec<&str> = text.split(' ').collect();
             let pose = limb_pose(&words).unwrap_or_else(|| panic!("{text}: no pose"));
