@@ -533,6 +533,17 @@ fn moves_on(
     out
 }
 
+/// The hand's place in a clause that touches a body point with it ("touches the right knee
+/// with the left hand", "taps his head with his left hand"): the point comes before the hand
+/// that goes there, across the "with" that parts the clause's phrases, so it is read from
+/// the touching verb on.
+fn touch_pose(words: &[&str]) -> Option<NamedPosture> {
+    let at = words
+        .iter()
+        .position(|w| limb_poses::TOUCHING.contains(w))?;
+    limb_poses::limb_pose(&words[at..])
+}
+
 /// Places each phrase of a clause about a limb in which the rules read no movement on the
 /// clause's segments (`made`): a place the limb holds ("with his right arm upwards",
 /// [`limb_poses`]) is returned, to be held on the limb's track over those segments; an arm
@@ -547,17 +558,16 @@ fn place_limb_phrases(
     notes: &mut Vec<String>,
 ) -> Vec<NamedPosture> {
     let mut held: Vec<NamedPosture> = Vec::new();
+    // "walking, taps his head with his left hand": the hand's words ("with his left hand")
+    // say only which hand, the place is before them.
+    if let Some(pose) = touch_pose(words) {
+        hold_place(pose, &words.join(" "), made, &mut held, notes);
+    }
     for (phrase, limb) in accounting::limb_phrases_without_movement(words, named) {
         let phrase_words: Vec<&str> = phrase.split(' ').collect();
         if let Some(pose) = limb_poses::limb_pose(&phrase_words) {
-            let taken = held
-                .iter()
-                .any(|h| h.parts.iter().any(|p| pose.parts.contains(p)));
-            match made.iter().find_map(|s| busy(s, &pose.parts)).or_else(|| {
-                (made.is_empty() || taken).then_some("another phrase of the clause moves it")
-            }) {
-                None => held.push(pose),
-                Some(why) => notes.push(format!("\"{phrase}\" {NOT_PLACED}: {why}")),
+            if !held.iter().any(|h| h.name == pose.name) {
+                hold_place(pose, &phrase, made, &mut held, notes);
             }
             continue;
         }
@@ -595,6 +605,28 @@ fn place_limb_phrases(
     held
 }
 
+/// Holds `pose` (a limb's place a phrase says) over the clause's segments, unless the
+/// clause's movement or another of its phrases moves that limb, which a note then says.
+fn hold_place(
+    pose: NamedPosture,
+    phrase: &str,
+    made: &[Segment],
+    held: &mut Vec<NamedPosture>,
+    notes: &mut Vec<String>,
+) {
+    let taken = held
+        .iter()
+        .any(|h| h.parts.iter().any(|p| pose.parts.contains(p)));
+    match made
+        .iter()
+        .find_map(|s| busy(s, &pose.parts))
+        .or_else(|| (made.is_empty() || taken).then_some("another phrase of the clause moves it"))
+    {
+        None => held.push(pose),
+        Some(why) => notes.push(format!("\"{phrase}\" {NOT_PLACED}: {why}")),
+    }
+}
+
 /// A clause that only says where limbs are ([`limb_poses`]): the body stands, on one leg if
 /// the clause says so (the segment's own posture), and the other places are held on their
 /// limbs over it. `None` when no limb phrase of the clause reads as a place.
@@ -606,16 +638,8 @@ fn standing_poses(words: &[&str]) -> Option<(Segment, Vec<NamedPosture>)> {
             poses.push(pose);
         }
     }
-    let touches = words.iter().any(|w| {
-        matches!(
-            *w,
-            "touches" | "touch" | "touching" | "presses" | "pressing" | "rests" | "resting"
-        )
-    });
-    if poses.is_empty() && touches {
-        // "touches the right knee with the left hand": the place comes before the limb that
-        // goes there, across the "with" that parts the phrases.
-        poses.extend(limb_poses::limb_pose(&lexicon::without_subject(words)));
+    if poses.is_empty() {
+        poses.extend(touch_pose(words));
     }
     if poses.is_empty() {
         return None;

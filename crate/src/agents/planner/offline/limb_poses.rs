@@ -63,9 +63,6 @@ const MOVING: &[&str] = &[
     "circle",
     "circles",
     "circling",
-    "tap",
-    "taps",
-    "tapping",
     "clap",
     "claps",
     "clapping",
@@ -90,15 +87,6 @@ const MOVING: &[&str] = &[
     "wiggle",
     "wiggles",
     "wiggling",
-    "rub",
-    "rubs",
-    "rubbing",
-    "scratch",
-    "scratches",
-    "scratching",
-    "wipe",
-    "wipes",
-    "wiping",
     "bounce",
     "bounces",
     "bouncing",
@@ -109,6 +97,36 @@ const MOVING: &[&str] = &[
     "forth",
     "alternately",
     "alternating",
+];
+
+/// Verbs of a hand going to a body point and staying on it, or coming back to it ("touches
+/// the right knee", "taps his head", "scratches his head", "wipes the forehead"): the hand's
+/// place is the point they name; with none they are movements ("tapping his right foot").
+pub(super) const TOUCHING: &[&str] = &[
+    "touch",
+    "touches",
+    "touching",
+    "tap",
+    "taps",
+    "tapping",
+    "pat",
+    "pats",
+    "patting",
+    "rub",
+    "rubs",
+    "rubbing",
+    "scratch",
+    "scratches",
+    "scratching",
+    "wipe",
+    "wipes",
+    "wiping",
+    "press",
+    "presses",
+    "pressing",
+    "rest",
+    "rests",
+    "resting",
 ];
 
 /// Where a limb is, as the words say it.
@@ -179,6 +197,10 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
         .iter()
         .any(|m| phrase.contains(m) || (m.contains(' ') && text.contains(m)))
     {
+        return None;
+    }
+    // A touch that names no point is a movement of its own ("tapping his right foot").
+    if has(phrase, TOUCHING) && target(phrase).is_none() && !has(phrase, &["knee", "knees"]) {
         return None;
     }
     if let Some(pose) = holding_pose(phrase) {
@@ -302,8 +324,37 @@ fn is_limb_determiner(word: &str) -> bool {
 
 /// Words after which a body point is what a hand touches, not what moves.
 const ONTO: &[&str] = &[
-    "on", "onto", "to", "at", "against", "over", "touching", "touches", "touch", "near",
-    "covering", "covers", "behind", "in",
+    "on",
+    "onto",
+    "to",
+    "at",
+    "against",
+    "over",
+    "touching",
+    "touches",
+    "touch",
+    "near",
+    "covering",
+    "covers",
+    "behind",
+    "in",
+    "tap",
+    "taps",
+    "tapping",
+    "pat",
+    "pats",
+    "patting",
+    "rub",
+    "rubs",
+    "rubbing",
+    "scratch",
+    "scratches",
+    "scratching",
+    "wipe",
+    "wipes",
+    "wiping",
+    "presses",
+    "pressing",
 ];
 
 /// Whether any of `words` is in the phrase.
@@ -870,6 +921,11 @@ mod tests {
                 "{text}"
             );
         }
+        assert_eq!(
+            read("taps his head with his left hand").map(|p| p.0),
+            Some("left hand on the head".into())
+        );
+        assert_eq!(read("tapping his right foot"), None);
         assert_eq!(
             read("with his right hand on his back").map(|p| p.0),
             Some("right hand behind the back".into())

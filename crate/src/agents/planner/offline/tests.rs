@@ -1176,4 +1176,18 @@ fn ending_leaving_and_sidestepping_are_movements_of_their_own() {
         assert_eq!(touch.clips[0].text, "left hand on the right knee");
         assert!(touch.notes.is_empty(), "{prompt}: {:?}", touch.notes);
     }
+    // A hand that taps or scratches a point goes there.
+    let tap = plan(
+        "Walking forward, the man taps his head with his left hand.",
+        None,
+    );
+    assert_eq!(tap.segments[0].base, "a person walks forward", "{tap:#?}");
+    assert_eq!(tap.clips.len(), 1, "{tap:#?}");
+    assert_eq!(tap.clips[0].text, "left hand on the head");
+    let scratch = plan(
+        "A man scratches his head with his right hand while standing still.",
+        None,
+    );
+    assert_eq!(scratch.clips.len(), 1, "{scratch:#?}");
+    assert_eq!(scratch.clips[0].text, "right hand on the head");
 }
