@@ -29,8 +29,9 @@ use burn::store::burn_pack::Tensor as PackTensor;
 use burn::store::{bridge, KeyRemapper, ModuleSnapshot, PyTorchToBurnAdapter, SafetensorsStore};
 use burn::tensor::activation::gelu;
 use burn::tensor::{f16, DType};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Width of the sentence embeddings and token states.
 pub const EMBEDDING_DIM: usize = 384;
@@ -539,7 +540,17 @@ pub struct SentenceEncoder {
     words: WordEmbeddings,
     model: MiniLm,
     device: Device,
+    /// Embeddings of single sentences already encoded, by text: a run conditions and scores
+    /// the same few sentences again and again (a segment's base for each of its edits, review
+    /// rounds and transitions, its text for each score), and each encoding is a pass of the
+    /// encoder. A sentence alone always encodes to the same bits (no padding), so the stored
+    /// one is the one a new pass would give.
+    single: Mutex<HashMap<String, [f32; EMBEDDING_DIM]>>,
 }
+
+/// Most sentences [`SentenceEncoder`] keeps: far more than one run says, few enough that a
+/// page left open for hours holds a bounded table (384 floats a sentence).
+const KEPT_SENTENCES: usize = 4096;
 
 // By hand: the derived form would print the whole vocabulary.
 impl std::fmt::Debug for SentenceEncoder {
@@ -579,6 +590,7 @@ impl SentenceEncoder {
             words,
             model,
             device: device.clone(),
+            single: Mutex::new(HashMap::new()),
         })
     }
 
@@ -636,8 +648,31 @@ impl SentenceEncoder {
     }
 
     /// One L2-normalised sentence embedding per text: the mean of its token states over real
-    /// tokens (`[CLS]` and `[SEP]` included, padding excluded), as sentence-transformers.
+    /// tokens (`[CLS]` and `[SEP]` included, padding excluded), as sentence-transformers. A
+    /// single sentence met before is answered from memory.
     pub fn encode(&self, texts: &[&str]) -> Vec<[f32; EMBEDDING_DIM]> {
+        if let [text] = texts {
+            // A poisoned lock only means a panic elsewhere mid-insert; the table is still
+            // whole entries.
+            let known = self.single.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(embedding) = known.get(*text) {
+                return vec![*embedding];
+            }
+            drop(known);
+            let embedding = self.encode_anew(texts)[0];
+            let mut known = self.single.lock().unwrap_or_else(|e| e.into_inner());
+            if known.len() >= KEPT_SENTENCES {
+                known.clear();
+            }
+            known.insert(text.to_string(), embedding);
+            return vec![embedding];
+        }
+        self.encode_anew(texts)
+    }
+
+    /// [`SentenceEncoder::encode`] with a pass of the encoder even for a sentence met before:
+    /// what timing the encoder measures.
+    pub fn encode_anew(&self, texts: &[&str]) -> Vec<[f32; EMBEDDING_DIM]> {
         if texts.is_empty() {
             return Vec::new();
         }
