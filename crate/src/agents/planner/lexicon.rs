@@ -361,6 +361,8 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
         | "marches" | "marching" | "shuffle" | "shuffles" | "shuffling" | "wander" | "wanders"
         | "wandering" | "pace" | "paces" | "pacing" | "steps" | "stepping" | "sidestep"
         | "sidesteps" | "sidestepping" => Action::Walk(Direction::Forward),
+        // "turns in a circle to the left" walks a circle, as "walks in a circle" does.
+        "turn" | "turns" | "turning" if near(next, &["circle"]) => Action::Walk(Direction::Forward),
         // "walks forward, turning left" walks; "turns to the left" on its own is the key-pose
         // library's turn on the spot.
         "turning" => {

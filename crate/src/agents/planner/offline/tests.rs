@@ -1190,4 +1190,24 @@ fn ending_leaving_and_sidestepping_are_movements_of_their_own() {
     );
     assert_eq!(scratch.clips.len(), 1, "{scratch:#?}");
     assert_eq!(scratch.clips[0].text, "right hand on the head");
+    // Postures and movements of the library by more of their names.
+    for (prompt, key) in [
+        (
+            "A man sits on the floor, then lies back.",
+            "lie on the back",
+        ),
+        (
+            "A man lies down on his back, then rolls onto his side.",
+            "lie on the side",
+        ),
+    ] {
+        let planned = plan(prompt, None);
+        let last = planned.segments.last().expect("segments");
+        assert_eq!(key_names(last), [key], "{prompt}: {planned:#?}");
+    }
+    // "turns in a circle" walks one, as "walks in a circle" does.
+    assert_eq!(
+        plan("The person turns in a circle to the left.", None).segments,
+        plan("The person walks in a circle to the left.", None).segments
+    );
 }
