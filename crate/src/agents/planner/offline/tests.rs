@@ -1210,4 +1210,17 @@ fn ending_leaving_and_sidestepping_are_movements_of_their_own() {
         plan("The person turns in a circle to the left.", None).segments,
         plan("The person walks in a circle to the left.", None).segments
     );
+    // A dive to a side lands on that side.
+    let dive = plan(
+        "The goalkeeper crouches, dives to the left, and gets back up.",
+        None,
+    );
+    assert_eq!(
+        key_names(&dive.segments[1]),
+        [
+            "diving to the left, arms reaching",
+            "landed on the left side"
+        ],
+        "{dive:#?}"
+    );
 }
