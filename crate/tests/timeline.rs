@@ -119,6 +119,26 @@ fn moved(a: &[Pose], b: &[Pose], frames: Range<usize>) -> (f64, f64) {
 /// rounding only.
 const UNCHANGED_M: f64 = 1e-4;
 
+/// Asserts that no joint of `b` outside the token `steps` moved from `a` (relative to the
+/// pelvis and in world space, before and after the steps), printing the largest moves.
+fn assert_unchanged_outside(a: &[Pose], b: &[Pose], steps: &Range<usize>, what: &str) {
+    let (before, after) = (
+        moved(a, b, 0..steps.start * FRAMES_PER_TOKEN),
+        moved(a, b, steps.end * FRAMES_PER_TOKEN..a.len()),
+    );
+    eprintln!(
+        "{what}: joints outside the affected steps {steps:?} move by up to {:.4} mm before and \
+         {:.4} mm after (relative to the pelvis), {:.4} mm and {:.4} mm in world space",
+        before.0 * 1e3,
+        after.0 * 1e3,
+        before.1 * 1e3,
+        after.1 * 1e3
+    );
+    for d in [before.0, before.1, after.0, after.1] {
+        assert!(d < UNCHANGED_M, "{what}: {d} m");
+    }
+}
+
 #[test]
 fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_and_entered() {
     let session = session();
@@ -141,21 +161,7 @@ fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_a
     // outside its reach the motion is theirs.
     assert_eq!(with.tokens.base(), without.tokens);
     let (a, b) = (joints(&without), joints(&with));
-    let (before, after) = (
-        moved(&a, &b, 0..reach.start * FRAMES_PER_TOKEN),
-        moved(&a, &b, reach.end * FRAMES_PER_TOKEN..a.len()),
-    );
-    eprintln!(
-        "laying the clip, joints outside its steps {reach:?} move by up to {:.4} mm before and \
-         {:.4} mm after (relative to the pelvis), {:.4} mm and {:.4} mm in world space",
-        before.0 * 1e3,
-        after.0 * 1e3,
-        before.1 * 1e3,
-        after.1 * 1e3
-    );
-    for d in [before.0, before.1, after.0, after.1] {
-        assert!(d < UNCHANGED_M, "{d} m");
-    }
+    assert_unchanged_outside(&a, &b, &reach, "laying the clip");
 
     // Moved later: only the steps of the old and the new span (and their seams) change.
     let mut moved_plan = waving.clone();
@@ -188,21 +194,7 @@ fn a_clip_changes_its_parts_over_its_span_and_moving_it_only_the_spans_it_left_a
     // integrated, but the base is decoded there and the clip's parts are taken from the final
     // tokens over the clip's steps only.
     let (a, b) = (joints(&with), joints(&moved_clip));
-    let (before, after) = (
-        moved(&a, &b, 0..both.start * FRAMES_PER_TOKEN),
-        moved(&a, &b, both.end * FRAMES_PER_TOKEN..a.len()),
-    );
-    eprintln!(
-        "joints relative to the pelvis outside the affected steps {both:?}: up to {:.4} mm \
-         before, {:.4} mm after; in world space {:.4} mm before, {:.4} mm after",
-        before.0 * 1e3,
-        after.0 * 1e3,
-        before.1 * 1e3,
-        after.1 * 1e3
-    );
-    for d in [before.0, before.1, after.0, after.1] {
-        assert!(d < UNCHANGED_M, "{d} m");
-    }
+    assert_unchanged_outside(&a, &b, &both, "moving the clip");
     // Inside, the waving arm moved with its clip.
     let (_, inside) = moved(
         &a,
@@ -267,21 +259,7 @@ fn a_legs_clip_moved_leaves_the_frames_outside_its_spans_as_they_were() {
     );
     let both = old.start.min(new.start)..old.end.max(new.end);
     let (a, b) = (joints(&with), joints(&moved_clip));
-    let (before, after) = (
-        moved(&a, &b, 0..both.start * FRAMES_PER_TOKEN),
-        moved(&a, &b, both.end * FRAMES_PER_TOKEN..a.len()),
-    );
-    eprintln!(
-        "moving a kick, joints outside the affected steps {both:?}: up to {:.4} mm before, \
-         {:.4} mm after (relative to the pelvis); {:.4} mm before, {:.4} mm after in world space",
-        before.0 * 1e3,
-        after.0 * 1e3,
-        before.1 * 1e3,
-        after.1 * 1e3
-    );
-    for d in [before.0, before.1, after.0, after.1] {
-        assert!(d < UNCHANGED_M, "{d} m");
-    }
+    assert_unchanged_outside(&a, &b, &both, "moving a kick");
     // Every bone keeps its length under the clip too, where the kick eases in and out.
     assert!(coma::skeleton::max_bone_deviation(&b) < 1e-3);
 }

@@ -533,14 +533,15 @@ fn moves_on(
     out
 }
 
-/// The hand's place in a clause that touches a body point with it ("touches the right knee
-/// with the left hand", "taps his head with his left hand"): the point comes before the hand
-/// that goes there, across the "with" that parts the clause's phrases, so it is read from
-/// the touching verb on.
+/// The hand's place in a clause that touches a body point with it or holds a thing ("touches
+/// the right knee with the left hand", "taps his head with his left hand", "holding a phone
+/// to the right ear"): the point comes before the hand that goes there, across the "with"
+/// that parts the clause's phrases, or no hand is named at all, so it is read from the verb
+/// on.
 fn touch_pose(words: &[&str]) -> Option<NamedPosture> {
     let at = words
         .iter()
-        .position(|w| limb_poses::TOUCHING.contains(w))?;
+        .position(|w| limb_poses::TOUCHING.contains(w) || limb_poses::HOLDING.contains(w))?;
     limb_poses::limb_pose(&words[at..])
 }
 

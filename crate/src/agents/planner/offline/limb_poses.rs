@@ -121,12 +121,6 @@ pub(super) const TOUCHING: &[&str] = &[
     "wipe",
     "wipes",
     "wiping",
-    "press",
-    "presses",
-    "pressing",
-    "rest",
-    "rests",
-    "resting",
 ];
 
 /// Where a limb is, as the words say it.
@@ -217,7 +211,7 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
         let stood_on = matches!(phrase[i], "leg" | "legs" | "foot" | "feet");
         phrase[i.saturating_sub(3)..i]
             .iter()
-            .any(|w| ONTO.contains(w) && !(stood_on && *w == "on"))
+            .any(|w| onto(w) && !(stood_on && *w == "on"))
     };
     let actors: Vec<&(usize, Kind, bool)> = nouns.iter().filter(|(i, ..)| !touched(*i)).collect();
     let &&(at, kind, plural) = actors.first()?;
@@ -243,26 +237,64 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
     }
 }
 
+/// Verbs of a hand that holds a thing.
+pub(super) const HOLDING: &[&str] = &[
+    "holding",
+    "holds",
+    "carrying",
+    "carries",
+    "clutching",
+    "clutches",
+    "gripping",
+    "grips",
+];
+
+/// A thing held to a point of the body on a side the words name, with no hand named
+/// ("holding a phone to the right ear"): the hand of that side, on that point.
+fn held_to_the_body(phrase: &[&str]) -> Option<NamedPosture> {
+    if phrase.iter().any(|w| limb_noun(w).is_some()) {
+        return None;
+    }
+    let verb = phrase.iter().position(|w| HOLDING.contains(w))?;
+    let (k, w) = phrase.windows(4).enumerate().find(|(_, w)| {
+        matches!(w[0], "to" | "against" | "at")
+            && Side::of_word(w[2]).is_some()
+            && Target::of_word(w[3]).is_some()
+    })?;
+    let side = Side::of_word(w[2])?;
+    let target = match Target::of_word(w[3])? {
+        Target::Hip(_) => Target::Hip(Some(side)),
+        Target::Knee(_) => Target::Knee(Some(side)),
+        Target::Shoulder(_) => Target::Shoulder(Some(side)),
+        other => other,
+    };
+    let thing = &phrase[verb + 1..k];
+    let thing = if thing.is_empty() || thing.len() > 4 {
+        "something".to_string()
+    } else {
+        thing.join(" ")
+    };
+    posture(
+        format!("{} hand holding {thing} to the {}", side.name(), w[3]),
+        vec![arm_part(side)],
+        arm_constraints(side, Place::On(target)),
+    )
+}
+
 /// The pose of a hand that holds a thing ("holding a cup in his right hand", "with a cane
 /// in her right hand", "carrying a tray on the left hand"): the hand the thing is in or on,
 /// held in front of the body. `None` when the phrase holds nothing in a hand it names.
 fn holding_pose(phrase: &[&str]) -> Option<NamedPosture> {
-    let holds = has(
-        phrase,
-        &[
-            "holding",
-            "holds",
-            "carrying",
-            "carries",
-            "clutching",
-            "clutches",
-            "gripping",
-            "grips",
-        ],
-    ) || matches!(phrase, ["with", "a" | "an", ..]);
+    let holds = has(phrase, HOLDING) || matches!(phrase, ["with", "a" | "an", ..]);
+    if !holds {
+        return None;
+    }
+    if let Some(pose) = held_to_the_body(phrase) {
+        return Some(pose);
+    }
     // One limb only: "carrying a tray on the left hand, the right arm tucked behind the
     // back" says the right arm's place.
-    if !holds || phrase.iter().filter(|w| limb_noun(w).is_some()).count() != 1 {
+    if phrase.iter().filter(|w| limb_noun(w).is_some()).count() != 1 {
         return None;
     }
     let at = phrase.iter().position(|w| matches!(*w, "hand" | "hands"))?;
@@ -324,38 +356,15 @@ fn is_limb_determiner(word: &str) -> bool {
 
 /// Words after which a body point is what a hand touches, not what moves.
 const ONTO: &[&str] = &[
-    "on",
-    "onto",
-    "to",
-    "at",
-    "against",
-    "over",
-    "touching",
-    "touches",
-    "touch",
-    "near",
-    "covering",
-    "covers",
-    "behind",
-    "in",
-    "tap",
-    "taps",
-    "tapping",
-    "pat",
-    "pats",
-    "patting",
-    "rub",
-    "rubs",
-    "rubbing",
-    "scratch",
-    "scratches",
-    "scratching",
-    "wipe",
-    "wipes",
-    "wiping",
-    "presses",
-    "pressing",
+    "on", "onto", "to", "at", "against", "over", "near", "covering", "covers", "behind", "in",
+    "presses", "pressing",
 ];
+
+/// Whether a body point after `word` is what a hand touches: after a word of [`ONTO`] or a
+/// touching verb ("taps **his head**").
+fn onto(word: &str) -> bool {
+    ONTO.contains(&word) || TOUCHING.contains(&word)
+}
 
 /// Whether any of `words` is in the phrase.
 fn has(phrase: &[&str], words: &[&str]) -> bool {
@@ -378,7 +387,7 @@ fn at_the_side(phrase: &[&str]) -> bool {
 /// the side the words give it.
 fn target(phrase: &[&str]) -> Option<Target> {
     let at = (0..phrase.len()).find(|&i| {
-        ONTO.contains(&phrase[i])
+        onto(phrase[i])
             && phrase[i + 1..phrase.len().min(i + 5)]
                 .iter()
                 .any(|w| Target::of_word(w).is_some())
@@ -886,9 +895,12 @@ mod tests {
             Some("right hand on the left knee".into())
         );
         assert_eq!(
-            read("holding a phone to the right ear").map(|p| p.0),
-            None,
-            "a phone names no limb"
+            read("holding a phone to the right ear"),
+            Some((
+                "right hand holding a phone to the ear".into(),
+                vec![BodyPart::RightArm]
+            )),
+            "the ear's side is the hand's"
         );
         assert_eq!(
             read("stretching the right leg out behind her"),
@@ -969,6 +981,7 @@ mod tests {
             "stands on the right leg",
             "holding a cup in his right hand",
             "carrying a box in both hands",
+            "holding a phone to the right ear",
         ] {
             let words: Vec<&str> = text.split(' ').collect();
             let pose = limb_pose(&words).unwrap_or_else(|| panic!("{text}: no pose"));
