@@ -180,16 +180,8 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                     .map(|pose| PostureTrack::holding(pose.parts, pose.script))
             });
             if let Some(track) = own_track {
-                segments.push(Segment {
-                    text: format!("a person {}", lexicon::without_subject(words).join(" ")),
-                    seconds: clamp_seconds(track.natural_seconds() + DEFAULT_TRANSITION_SECONDS)
-                        .unwrap_or(2.0)
-                        .max(2.0),
-                    base: "a person stands still".into(),
-                    parts: PartEdits::default(),
-                    trajectory: None,
-                    postures: Some(track),
-                });
+                let text = format!("a person {}", lexicon::without_subject(words).join(" "));
+                segments.push(standing_segment(text, Some(track)));
                 previous = None;
                 ends_standing = None;
                 break 'clause;
@@ -667,22 +659,25 @@ fn standing_poses(words: &[&str]) -> Option<(Segment, Vec<NamedPosture>)> {
         ),
         None => ("a person stands still".to_string(), None),
     };
+    Some((standing_segment(text, postures), kept))
+}
+
+/// A segment over the model's standing, made by key poses the rules write (`postures`, if
+/// any): as long as the poses take at their own pace with the way into them, 2 s at least.
+fn standing_segment(text: String, postures: Option<PostureTrack>) -> Segment {
     let seconds = postures
         .as_ref()
         .and_then(|t| clamp_seconds(t.natural_seconds() + DEFAULT_TRANSITION_SECONDS))
         .unwrap_or(2.0)
         .max(2.0);
-    Some((
-        Segment {
-            text,
-            seconds,
-            base: "a person stands still".into(),
-            parts: PartEdits::default(),
-            trajectory: None,
-            postures,
-        },
-        kept,
-    ))
+    Segment {
+        text,
+        seconds,
+        base: "a person stands still".into(),
+        parts: PartEdits::default(),
+        trajectory: None,
+        postures,
+    }
 }
 
 /// Why a segment cannot have a pose held on `parts` over it, if it cannot: an instruction or

@@ -249,6 +249,16 @@ pub(super) const HOLDING: &[&str] = &[
     "grips",
 ];
 
+/// The thing held, as the words name it ("a cup"); "something" when they name none, or
+/// more than a short noun phrase.
+fn thing_named(words: &[&str]) -> String {
+    if words.is_empty() || words.len() > 4 {
+        "something".to_string()
+    } else {
+        words.join(" ")
+    }
+}
+
 /// A thing held to a point of the body on a side the words name, with no hand named
 /// ("holding a phone to the right ear"): the hand of that side, on that point.
 fn held_to_the_body(phrase: &[&str]) -> Option<NamedPosture> {
@@ -268,12 +278,7 @@ fn held_to_the_body(phrase: &[&str]) -> Option<NamedPosture> {
         Target::Shoulder(_) => Target::Shoulder(Some(side)),
         other => other,
     };
-    let thing = &phrase[verb + 1..k];
-    let thing = if thing.is_empty() || thing.len() > 4 {
-        "something".to_string()
-    } else {
-        thing.join(" ")
-    };
+    let thing = thing_named(&phrase[verb + 1..k]);
     posture(
         format!("{} hand holding {thing} to the {}", side.name(), w[3]),
         vec![arm_part(side)],
@@ -318,30 +323,12 @@ fn holding_pose(phrase: &[&str]) -> Option<NamedPosture> {
     // The thing held, as the words name it ("a cup", "a cane"), up to where the hand is.
     let verb = phrase
         .iter()
-        .position(|w| {
-            matches!(
-                *w,
-                "holding"
-                    | "holds"
-                    | "carrying"
-                    | "carries"
-                    | "clutching"
-                    | "clutches"
-                    | "gripping"
-                    | "grips"
-                    | "with"
-            )
-        })
+        .position(|w| HOLDING.contains(w) || *w == "with")
         .filter(|v| *v < at)?;
     let until = (verb + 1..at)
         .find(|&k| matches!(phrase[k], "in" | "on"))
         .unwrap_or(at);
-    let thing = &phrase[verb + 1..until];
-    let thing = if thing.is_empty() || thing.len() > 4 {
-        "something".to_string()
-    } else {
-        thing.join(" ")
-    };
+    let thing = thing_named(&phrase[verb + 1..until]);
     let parts = sides.iter().map(|s| arm_part(*s)).collect();
     posture(format!("{hands} holding {thing}"), parts, constraints)
 }
