@@ -17,7 +17,7 @@ use crate::dataset::Split;
 use crate::model::evaluator::Evaluator;
 use crate::model::generate::SamplingOptions;
 use crate::model::MotionModel;
-use crate::session::Session;
+use crate::session::{read_vocabulary, Session, VOCABULARY_FILE};
 use crate::text::minilm::SentenceEncoder;
 use anyhow::Result;
 use burn::tensor::Device;
@@ -164,15 +164,16 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
         }
     }
     log(&format!("embedded {} distinct captions", sentences.len()));
-    // SPAM runs in the engine, with this evaluator as the review loop's judge; the
-    // evaluation needs no vocabulary (the built-in planner plans).
+    // SPAM runs in the engine, with this evaluator as the review loop's judge and the
+    // model's vocabulary, so the built-in planner plans as it does in the page and the CLI.
     let session = options
         .spam
-        .map(|dir| MotionModel::load(dir, &device))
+        .map(|dir| MotionModel::load(dir, &device).map(|model| (dir, model)))
         .transpose()?
-        .map(|model| {
+        .map(|(dir, model)| {
             let judge = Ok((evaluator.clone(), config.clone()));
-            Session::new(model, judge, Err("not used by the evaluation".into())).0
+            let vocabulary = read_vocabulary(&dir.join(VOCABULARY_FILE));
+            Session::new(model, judge, vocabulary).0
         });
     let spam = session.as_ref().map(Session::model);
     if let (Some(model), Some(dir)) = (spam, options.spam) {

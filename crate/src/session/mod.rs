@@ -26,8 +26,8 @@ use crate::agents::pipeline::{self, RunOptions};
 use crate::agents::reviewer::Scorer;
 use crate::dataset::Vocabulary;
 use crate::features::{
-    features_to_joints, reference_fit, with_reference_bones, with_reference_bones_fitted,
-    FeatureFrame, Features, VELOCITIES,
+    features_to_joints, reference_fit, with_joint_rotations, with_reference_bones,
+    with_reference_bones_fitted, FeatureFrame, Features, VELOCITIES,
 };
 use crate::feet::plant_feet;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
@@ -389,8 +389,8 @@ impl Session {
 /// the reference skeleton of `fit`, the plan's key postures laid, the feet planted; with the
 /// notes of the key poses that could not be met in full.
 ///
-/// Every motion the engine answers with is finished here, and here it gets the one skeleton
-/// ([`with_reference_bones`]): the model predicts each joint on its own, so its bones
+/// Every motion the engine answers with is finished here: its rotations become those of its
+/// joints ([`with_joint_rotations`]), and it gets the one skeleton ([`with_reference_bones`]): the model predicts each joint on its own, so its bones
 /// stretch; fixed once in the features, the joints shown, the BVH, the JSON and both NPY
 /// exports all describe the same motion on the same bones. Here too its feet are planted
 /// ([`plant_feet`]), whatever made it.
@@ -400,7 +400,7 @@ fn finished(
     tokens: &MotionTokens,
     plan: Option<&Plan>,
 ) -> (Features, Vec<String>) {
-    let features = with_reference_bones_fitted(features, fit);
+    let features = with_reference_bones_fitted(&with_joint_rotations(features), fit);
     let (features, notes) = match plan {
         Some(plan)
             if plan.segments.iter().any(|s| s.postures.is_some())
@@ -423,7 +423,7 @@ fn finished(
 /// key postures on them: on the reference skeleton, feet planted. The evaluation measures
 /// SPAM's motions through it, so it measures what a user sees.
 pub fn finish(features: &[FeatureFrame]) -> Features {
-    plant_feet(&with_reference_bones(features), &[])
+    plant_feet(&with_reference_bones(&with_joint_rotations(features)), &[])
 }
 
 /// The training vocabulary from its file.
