@@ -128,6 +128,10 @@ pub struct Library {
     pub postures: Vec<NamedPosture>,
     /// The movements in file order.
     pub actions: Vec<Action>,
+    /// Every phrase of every posture and movement, normalised once ([`normalise`]), with
+    /// the index in [`Library::all`] of what it names: [`Library::mentions`] reads every
+    /// clause of every prompt against all of them.
+    phrases: Vec<(String, usize)>,
 }
 
 /// Something the library names in a text.
@@ -296,11 +300,12 @@ impl Library {
                 script,
             });
         }
-        let library = Library {
+        let mut library = Library {
             postures,
             actions: Vec::new(),
+            phrases: Vec::new(),
         };
-        library.unambiguous()?;
+        library.index_phrases()?;
         Ok(library)
     }
 
@@ -375,31 +380,44 @@ impl Library {
             action.track(None, [0.0, 1.0]).checked().map_err(fail)?;
             self.actions.push(action);
         }
-        self.unambiguous()?;
+        self.index_phrases()?;
         Ok(self)
     }
 
-    /// No phrase may name two things: the planner could not tell which was meant.
-    fn unambiguous(&self) -> Result<(), LibraryError> {
-        let mut seen: Vec<(String, &str)> = Vec::new();
-        for named in self.all() {
-            let phrases = named.phrases();
-            for phrase in phrases {
+    /// Normalises every phrase once, refusing a phrase that names two things: the planner
+    /// could not tell which was meant.
+    fn index_phrases(&mut self) -> Result<(), LibraryError> {
+        let mut phrases: Vec<(String, usize)> = Vec::new();
+        for (i, named) in self.all().enumerate() {
+            for phrase in named.phrases() {
                 let phrase = normalise(&phrase);
-                match seen.iter().find(|(s, _)| *s == phrase) {
-                    Some((_, first)) if *first != named.name() => {
-                        return Err(LibraryError::Ambiguous {
-                            phrase,
-                            first: first.to_string(),
-                            second: named.name().to_string(),
-                        })
+                match phrases.iter().find(|(s, _)| *s == phrase) {
+                    Some(&(_, first)) if first != i => {
+                        let first = self.named(first).name().to_string();
+                        if first != named.name() {
+                            return Err(LibraryError::Ambiguous {
+                                phrase,
+                                first,
+                                second: named.name().to_string(),
+                            });
+                        }
                     }
                     Some(_) => {}
-                    None => seen.push((phrase, named.name())),
+                    None if phrase.is_empty() => {}
+                    None => phrases.push((phrase, i)),
                 }
             }
         }
+        self.phrases = phrases;
         Ok(())
+    }
+
+    /// The `i`-th of [`Library::all`].
+    fn named(&self, i: usize) -> Named<'_> {
+        match self.postures.get(i) {
+            Some(p) => Named::Posture(p),
+            None => Named::Action(&self.actions[i - self.postures.len()]),
+        }
     }
 
     /// Every posture, then every movement.
@@ -443,9 +461,10 @@ impl Library {
     /// The posture a name or synonym denotes exactly (case, spaces, hyphens ignored).
     pub fn get(&self, name: &str) -> Option<&NamedPosture> {
         let wanted = normalise(name);
-        self.postures
+        self.phrases
             .iter()
-            .find(|p| p.phrases().any(|ph| normalise(&ph) == wanted))
+            .find(|(phrase, _)| *phrase == wanted)
+            .and_then(|&(_, i)| self.postures.get(i))
     }
 
     /// Postures and movements named in a text, with the byte range of the longest phrase that
@@ -453,26 +472,19 @@ impl Library {
     pub fn mentions(&self, text: &str) -> Vec<(std::ops::Range<usize>, Named<'_>)> {
         let (flat, map) = normalise_with_map(text);
         let mut found: Vec<(std::ops::Range<usize>, Named<'_>)> = Vec::new();
-        for named in self.all() {
-            let phrases = named.phrases();
-            for phrase in phrases {
-                let phrase = normalise(&phrase);
-                if phrase.is_empty() {
-                    continue;
+        for (phrase, i) in &self.phrases {
+            let mut from = 0;
+            while let Some(at) = flat[from..].find(phrase.as_str()) {
+                let start = from + at;
+                let end = start + phrase.len();
+                let bounded = (start == 0 || flat.as_bytes()[start - 1] == b' ')
+                    && (end == flat.len() || flat.as_bytes()[end] == b' ');
+                if bounded {
+                    let last = map[end - 1];
+                    let stop = last + text[last..].chars().next().map_or(1, char::len_utf8);
+                    found.push((map[start]..stop, self.named(*i)));
                 }
-                let mut from = 0;
-                while let Some(at) = flat[from..].find(&phrase) {
-                    let start = from + at;
-                    let end = start + phrase.len();
-                    let bounded = (start == 0 || flat.as_bytes()[start - 1] == b' ')
-                        && (end == flat.len() || flat.as_bytes()[end] == b' ');
-                    if bounded {
-                        let last = map[end - 1];
-                        let stop = last + text[last..].chars().next().map_or(1, char::len_utf8);
-                        found.push((map[start]..stop, named));
-                    }
-                    from = start + 1;
-                }
+                from = start + 1;
             }
         }
         // Longer phrases first, then keep those that overlap nothing kept.

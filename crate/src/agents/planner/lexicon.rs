@@ -374,7 +374,10 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
                 return None;
             }
         }
-        "run" | "runs" | "running" | "ran" | "jog" | "jogs" | "jogging" | "jogged" => Action::Run,
+        "run" | "runs" | "running" | "ran" | "jog" | "jogs" | "jogging" | "jogged" | "hurry"
+        | "hurries" | "hurrying" | "hurried" | "rush" | "rushes" | "rushing" | "rushed" => {
+            Action::Run
+        }
         "sprint" | "sprints" | "sprinting" | "dash" | "dashes" | "dashing" | "races" => {
             Action::Dash
         }

@@ -224,6 +224,117 @@ pub(super) fn limbs_left_unplaced(
     out
 }
 
+/// Words of a phrase that do not say how the body moves: function words, the anaphora and
+/// counts the rules read on their own ("does it again", "twice"), manner words the timing
+/// reads ("slowly"), and the instrument words of [`is_instrument_word`].
+fn is_movement_content(word: &str) -> bool {
+    word.len() >= 4
+        && word.chars().all(char::is_alphabetic)
+        && !is_instrument_word(word)
+        && !lexicon::is_subject_noun(word)
+        && !matches!(
+            word,
+            "from"
+                | "into"
+                | "onto"
+                | "over"
+                | "under"
+                | "like"
+                | "then"
+                | "when"
+                | "while"
+                | "whilst"
+                | "again"
+                | "same"
+                | "thing"
+                | "once"
+                | "twice"
+                | "more"
+                | "times"
+                | "also"
+                | "just"
+                | "very"
+                | "still"
+                | "slowly"
+                | "quickly"
+                | "gently"
+                | "forth"
+                | "little"
+                | "each"
+                | "other"
+                | "there"
+                | "that"
+                | "this"
+                | "what"
+                | "does"
+                | "doing"
+                | "keeps"
+                | "keeping"
+                | "holds"
+                | "holding"
+        )
+}
+
+/// A word without its inflection, enough to match its other forms ("raised", "raises" and
+/// "raise"; "hops" and "hopping"). Written here because the planner needs this one
+/// comparison, not a language's stemmer.
+fn stem(word: &str) -> &str {
+    let mut w = word;
+    for suffix in ["ing", "ed", "es", "s"] {
+        if let Some(rest) = w.strip_suffix(suffix).filter(|r| r.len() >= 3) {
+            w = rest;
+            break;
+        }
+    }
+    let b = w.as_bytes();
+    if b.len() >= 4 && b[b.len() - 1] == b[b.len() - 2] && !b"aeiou".contains(&b[b.len() - 1]) {
+        w = &w[..w.len() - 1];
+    }
+    w.strip_suffix('e').filter(|r| r.len() >= 3).unwrap_or(w)
+}
+
+/// The phrases riding on a clause that left no trace in what the planner made of it (`made`:
+/// the segments' base texts, part instructions and key-pose names, and the clause's notes):
+/// the clause cut at its boundaries and openers, and where a limb noun follows another one
+/// ("on the right foot, arms flapping like wings"); the first phrase is the one the clause's
+/// movement came from, so only the others are read. A phrase with words about the movement
+/// ([`is_movement_content`]) none of which, nor of its limbs ("touches the right **knee**"),
+/// shares a stem with a word of `made` is one. The rules make most phrases into something or
+/// name them; this names the rest, so nothing a person asked for disappears without a word.
+pub(super) fn phrases_without_trace(words: &[&str], made: &[String]) -> Vec<String> {
+    let made_stems: Vec<&str> = made
+        .iter()
+        .flat_map(|t| t.split(|c: char| !c.is_alphanumeric()))
+        .filter(|w| !w.is_empty())
+        .map(stem)
+        .collect();
+    let mut phrases: Vec<Vec<&str>> = vec![Vec::new()];
+    for (i, w) in words.iter().enumerate() {
+        let after_limb = i > 0 && limb(words[i - 1]).is_some() && limb(w).is_some();
+        if BOUNDARIES.contains(w) {
+            phrases.push(Vec::new());
+            continue;
+        }
+        if OPENERS.contains(w) || after_limb {
+            phrases.push(Vec::new());
+        }
+        phrases.last_mut().expect("one phrase at least").push(w);
+    }
+    phrases
+        .into_iter()
+        .skip_while(Vec::is_empty)
+        .skip(1)
+        .filter(|phrase| {
+            phrase.iter().any(|w| is_movement_content(w))
+                && !phrase
+                    .iter()
+                    .filter(|w| is_movement_content(w) || limb(w).is_some())
+                    .any(|w| made_stems.contains(&stem(w)))
+        })
+        .map(|phrase| phrase.join(" "))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -281,6 +392,35 @@ mod tests {
             ..stand
         };
         assert!(limbs_left_unplaced(&w, &[kick], &[], &[]).is_empty());
+    }
+
+    #[test]
+    fn a_phrase_that_left_no_trace_is_found_and_one_that_did_is_not() {
+        let clause = words("the child hops forward on the right foot arms flapping like wings");
+        let made = ["hopping on the right foot".to_string()];
+        assert_eq!(
+            phrases_without_trace(&clause, &made),
+            ["arms flapping like wings"]
+        );
+        // A raise read from "raised", a walk from "strolls forward": forms of the same words.
+        let clause = words("a man strolls forward with arms raised");
+        let made = [
+            "a person walks forward".to_string(),
+            "a person raises both arms".to_string(),
+        ];
+        assert!(phrases_without_trace(&clause, &made).is_empty());
+        for (a, b) in [
+            ("hops", "hopping"),
+            ("raised", "raise"),
+            ("dances", "dancing"),
+        ] {
+            assert_eq!(stem(a), stem(b), "{a} / {b}");
+        }
+        // A hand put on a knee: the knee is in what was made.
+        let clause = words("a person touches the right knee with the left hand");
+        assert!(phrases_without_trace(&clause, &["left hand on the right knee".into()]).is_empty());
+        // Anaphora and counts are read by their own rules.
+        assert!(phrases_without_trace(&words("does it again twice"), &[]).is_empty());
     }
 
     #[test]

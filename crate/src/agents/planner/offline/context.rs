@@ -207,8 +207,21 @@ pub(super) fn without_context<'a>(
         .zip(&moves)
         .map(|(words, moves)| whole_clause(words, *moves))
         .collect();
+    // "a woman hurries forward" has a verb the rules may not know: the word after a subject.
+    let has_subject = |words: &[&str]| {
+        let rest = lexicon::without_subject(words).len();
+        rest > 0
+            && words[..words.len() - rest].iter().any(|w| {
+                lexicon::is_subject_noun(w)
+                    || matches!(
+                        *w,
+                        "he" | "she" | "they" | "someone" | "somebody" | "person"
+                    )
+            })
+    };
     let verbless = |k: usize| {
         !moves[k]
+            && !has_subject(&clauses[k])
             && !clauses[k]
                 .iter()
                 .any(|w| lexicon::is_finite_verb(w) || postures::is_posture_verb(w))

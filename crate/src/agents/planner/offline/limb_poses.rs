@@ -149,6 +149,8 @@ enum Target {
     Chest,
     Belly,
     Hip(Option<Side>),
+    /// A trouser pocket: the hip's pose, said as the words say it.
+    Pocket(Option<Side>),
     Knee(Option<Side>),
     Shoulder(Option<Side>),
 }
@@ -161,13 +163,31 @@ impl Target {
             "neck" | "throat" => Target::Neck,
             "chest" | "heart" | "breast" => Target::Chest,
             "belly" | "stomach" | "tummy" | "abdomen" => Target::Belly,
-            "hip" | "hips" | "waist" | "pocket" | "pockets" | "thigh" | "thighs" => {
-                Target::Hip(None)
-            }
+            "hip" | "hips" | "waist" | "thigh" | "thighs" => Target::Hip(None),
+            "pocket" | "pockets" => Target::Pocket(None),
             "knee" | "knees" => Target::Knee(None),
             "shoulder" | "shoulders" => Target::Shoulder(None),
             _ => return None,
         })
+    }
+
+    /// The same point on the side given; points of no side stay as they are.
+    fn on_side(self, side: Option<Side>) -> Target {
+        match self {
+            Target::Hip(_) => Target::Hip(side),
+            Target::Pocket(_) => Target::Pocket(side),
+            Target::Knee(_) => Target::Knee(side),
+            Target::Shoulder(_) => Target::Shoulder(side),
+            other => other,
+        }
+    }
+
+    /// The side of the body it is on, where it has one and the words said it.
+    fn side(self) -> Option<Side> {
+        match self {
+            Target::Hip(s) | Target::Pocket(s) | Target::Knee(s) | Target::Shoulder(s) => s,
+            _ => None,
+        }
     }
 
     fn words(self) -> &'static str {
@@ -177,6 +197,7 @@ impl Target {
             Target::Chest => "the chest",
             Target::Belly => "the belly",
             Target::Hip(_) => "the hip",
+            Target::Pocket(_) => "the pocket",
             Target::Knee(_) => "the knee",
             Target::Shoulder(_) => "the shoulder",
         }
@@ -272,12 +293,7 @@ fn held_to_the_body(phrase: &[&str]) -> Option<NamedPosture> {
             && Target::of_word(w[3]).is_some()
     })?;
     let side = Side::of_word(w[2])?;
-    let target = match Target::of_word(w[3])? {
-        Target::Hip(_) => Target::Hip(Some(side)),
-        Target::Knee(_) => Target::Knee(Some(side)),
-        Target::Shoulder(_) => Target::Shoulder(Some(side)),
-        other => other,
-    };
+    let target = Target::of_word(w[3])?.on_side(Some(side));
     let thing = thing_named(&phrase[verb + 1..k]);
     posture(
         format!("{} hand holding {thing} to the {}", side.name(), w[3]),
@@ -385,12 +401,7 @@ fn target(phrase: &[&str]) -> Option<Target> {
         .enumerate()
         .find_map(|(k, w)| Target::of_word(w).map(|t| (k, t)))?;
     let side = rest[..k].iter().rev().find_map(|w| Side::of_word(w));
-    Some(match found {
-        Target::Hip(_) => Target::Hip(side),
-        Target::Knee(_) => Target::Knee(side),
-        Target::Shoulder(_) => Target::Shoulder(side),
-        other => other,
-    })
+    Some(found.on_side(side))
 }
 
 /// Where the words put an arm.
@@ -536,10 +547,8 @@ fn arm_pose(phrase: &[&str], sides: &[Side]) -> Option<NamedPosture> {
         ),
         Place::Holding => format!("{hands} holding something"),
         Place::On(t) => {
-            let on = match t {
-                Target::Hip(Some(s)) | Target::Knee(Some(s)) | Target::Shoulder(Some(s)) => {
-                    t.words().replace("the ", &format!("the {} ", s.name()))
-                }
+            let on = match t.side() {
+                Some(s) => t.words().replace("the ", &format!("the {} ", s.name())),
                 _ if both => format!("{}s", t.words())
                     .replace("the heads", "the head")
                     .replace("the necks", "the neck")
@@ -547,7 +556,12 @@ fn arm_pose(phrase: &[&str], sides: &[Side]) -> Option<NamedPosture> {
                     .replace("the bellys", "the belly"),
                 _ => t.words().to_string(),
             };
-            format!("{hands} on {on}")
+            let at = if matches!(t, Target::Pocket(_)) {
+                "in"
+            } else {
+                "on"
+            };
+            format!("{hands} {at} {on}")
         }
     };
     let parts = sides.iter().map(|s| arm_part(*s)).collect();
@@ -662,7 +676,7 @@ fn arm_constraints(side: Side, place: Place) -> Vec<Constraint> {
                     rel(hand, BodyPoint::Chest, Relation::Below),
                     bend(Bend::PartiallyBent),
                 ],
-                Target::Hip(s) => vec![
+                Target::Hip(s) | Target::Pocket(s) => vec![
                     close(point(s, BodyPoint::LeftHip, BodyPoint::RightHip, hip)),
                     bend(Bend::PartiallyBent),
                 ],

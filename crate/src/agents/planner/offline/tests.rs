@@ -225,6 +225,22 @@ fn context_that_is_not_motion_is_dropped() {
 }
 
 #[test]
+fn a_setting_before_a_clause_drops_only_the_setting() {
+    // "hurries" is a verb after its subject: the clause moves, and only "in the rain" is
+    // context.
+    let plan = plan(
+        "In the rain, a woman hurries forward holding her coat closed with both hands.",
+        None,
+    );
+    assert_eq!(plan.segments[0].base, "a person runs forward");
+    assert!(plan
+        .notes
+        .iter()
+        .any(|n| n.starts_with("\"in the rain\" says where")));
+    assert!(!plan.notes.iter().any(|n| n.contains("\"a woman hurries")));
+}
+
+#[test]
 fn unknown_movements_go_to_the_nearest_action_with_an_embedder() {
     // A toy embedder: one dimension per word, so "spins around dancing" is nearest to
     // "a person dances" by shared words. MiniLM does this by meaning.
