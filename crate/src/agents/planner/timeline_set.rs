@@ -497,6 +497,25 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
                 None => (start, end),
             };
             let names = distinct_names(track.keys.iter().map(|k| &k.script));
+            // Arms held in a posture through a whole-body movement are on the arms' tracks.
+            let held = held_arms(&names).filter(|_| posture_body);
+            let names = held.as_ref().map_or(names, |(names, _, _)| names.clone());
+            if let Some((_, arms_text, arms)) = held {
+                let (from, to) = match track.within {
+                    Some([a, b]) => ((start + a).min(end), (start + b).min(end)),
+                    None => (start, end),
+                };
+                out.push(Element {
+                    on: On::Parts(arms),
+                    aliases: library_words(&arms_text, std::slice::from_ref(&arms_text)),
+                    text: arms_text,
+                    start: from,
+                    end: to,
+                    count: 1,
+                    path: None,
+                    segment: k,
+                });
+            }
             let text = library_movement(&names).unwrap_or_else(|| names.join(", "));
             let aliases = library_words(&text, &names);
             let text = format!("{text}{}", way(track));
@@ -586,6 +605,53 @@ fn distinct_names<'a>(scripts: impl Iterator<Item = &'a PostureScript>) -> Vec<S
         }
     }
     names
+}
+
+/// The arms' posture a planner laid into every key pose of a track ("left knee up with
+/// T-pose", "right knee up with T-pose": a jog in place with the arms in a T-pose), read from
+/// the key names: the names without it, its name, and the arms it holds (the library's, else
+/// the arm its words name, else both). `None` when the keys share no such posture, or what
+/// they share is not of the arms.
+fn held_arms(names: &[String]) -> Option<(Vec<String>, String, Vec<BodyPart>)> {
+    let split: Vec<(&str, &str)> = names
+        .iter()
+        .map(|n| n.split_once(" with "))
+        .collect::<Option<_>>()?;
+    let held = split[0].1;
+    if split.iter().any(|(_, h)| *h != held) {
+        return None;
+    }
+    let named = |word: &str| held.split(' ').any(|w| w == word);
+    let arm_words = [
+        "arm", "arms", "hand", "hands", "fist", "fists", "elbow", "elbows",
+    ];
+    let leg_words = [
+        "leg", "legs", "foot", "feet", "knee", "knees", "toe", "toes",
+    ];
+    let arms = match Library::builtin().get(held) {
+        Some(p) => p.parts.clone(),
+        // What the words hold must be an arm ("step forward with the left foot" is a step).
+        None if !arm_words.iter().any(|w| named(w)) || leg_words.iter().any(|w| named(w)) => {
+            return None
+        }
+        None if named("left") && !named("right") => vec![BodyPart::LeftArm],
+        None if named("right") && !named("left") => vec![BodyPart::RightArm],
+        None => vec![BodyPart::LeftArm, BodyPart::RightArm],
+    };
+    if arms.is_empty()
+        || arms
+            .iter()
+            .any(|p| !matches!(p, BodyPart::LeftArm | BodyPart::RightArm))
+    {
+        return None;
+    }
+    let mut bases: Vec<String> = Vec::new();
+    for (base, _) in &split {
+        if !bases.iter().any(|b| b == base) {
+            bases.push(base.to_string());
+        }
+    }
+    Some((bases, held.to_string(), arms))
 }
 
 /// The posture library's movement whose key poses a track plays, by their names: a track of

@@ -89,6 +89,33 @@ fn is_verb(word: &str, known: Repertoire) -> bool {
         || (known.knows_any() && lexicon::is_dataset_verb(word))
 }
 
+/// After a comma, a verb the lists do not hold followed by its object's determiner ("…, ties
+/// her right shoe", "…, grabs the rail"): a clause of its own. After "and" the same words
+/// more often finish the clause before ("dribbles and shoots a basketball").
+fn verb_with_object(words: &[String]) -> bool {
+    match words {
+        [verb, next, ..] => {
+            matches!(
+                next.as_str(),
+                "his" | "her" | "their" | "its" | "the" | "a" | "an"
+            ) && verb_form(verb)
+        }
+        _ => false,
+    }
+}
+
+/// A word that may be a verb by its form: in "-s", not a limb, a person or a word the
+/// prompts use as a plural noun.
+fn verb_form(word: &str) -> bool {
+    word.len() > 3
+        && word.ends_with('s')
+        && !word.ends_with("ss")
+        && accounting::limb(word).is_none()
+        && !matches!(word, "shoulders" | "hips" | "eyes" | "heads" | "others")
+        && !lexicon::is_subject_noun(word)
+        && !lexicon::is_subject_word(word)
+}
+
 /// A verb the lists do not hold, read from its form: a word in "-s" followed by a particle
 /// of direction ("ducks down", "scoots back", "drops to one knee"). Limbs and people in "-s"
 /// ("arms up", "the twins forward") are nouns.
@@ -112,14 +139,7 @@ fn unknown_verb(word: &str, next: Option<&str>) -> bool {
         "into",
         "to",
     ];
-    word.len() > 3
-        && word.ends_with('s')
-        && !word.ends_with("ss")
-        && next.is_some_and(|n| PARTICLES.contains(&n))
-        && accounting::limb(word).is_none()
-        && !matches!(word, "shoulders" | "hips" | "eyes" | "heads" | "others")
-        && !lexicon::is_subject_noun(word)
-        && !lexicon::is_subject_word(word)
+    next.is_some_and(|n| PARTICLES.contains(&n)) && verb_form(word)
 }
 
 /// True when the words up to the next comma or "and" only point back at the movement before
@@ -293,6 +313,7 @@ fn sentence_clauses(sentence: &[String], known: Repertoire) -> Vec<Vec<String>> 
                 if connective
                     || opening
                     || starts_verb(&rest[after..], known)
+                    || verb_with_object(&rest[after..])
                     || starts_connective(rest)
                     || points_back(&rest[after..])
                 {

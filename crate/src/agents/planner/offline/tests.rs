@@ -980,6 +980,12 @@ fn a_verb_no_list_holds_is_read_by_its_form() {
     // Limbs in "-s" are no verbs.
     let texts = clauses("she jumps, arms up", Repertoire::new(None));
     assert_eq!(texts.len(), 1, "{texts:?}");
+    // After a comma, a word in "-s" with its object is a verb; after "and" it may finish the
+    // clause before.
+    let split = |t: &str| clauses(t, Repertoire::new(None)).len();
+    assert_eq!(split("she kneels on the left knee, ties her right shoe"), 2);
+    assert_eq!(split("he dribbles and shoots a basketball"), 1);
+    assert_eq!(split("she walks forward, hands on the hips"), 1);
 }
 
 #[test]

@@ -491,6 +491,28 @@ fn a_substitute_in_a_note_does_not_account_for_a_clause() {
 }
 
 #[test]
+fn arms_held_through_a_movement_of_key_poses_are_on_the_arms() {
+    let p = crate::agents::planner::offline::plan(
+        "Someone jogs in place with both arms stretched out to the sides.",
+        None,
+    );
+    let elements = plan_elements(&p);
+    let arms: Vec<&Element> = elements
+        .iter()
+        .filter(|e| e.on == On::Parts(vec![BodyPart::LeftArm, BodyPart::RightArm]))
+        .collect();
+    assert_eq!(arms.len(), 1, "{elements:?}");
+    assert_eq!(arms[0].text, "T-pose");
+    let body: Vec<&Element> = elements.iter().filter(|e| e.on == On::Body).collect();
+    assert_eq!(body.len(), 1, "{elements:?}");
+    assert_eq!(body[0].text, "jog in place");
+    assert_eq!((arms[0].start, arms[0].end), (body[0].start, body[0].end));
+    // Key poses that hold nothing in common, or a leg's, are left as they are.
+    assert_eq!(held_arms(&["crouch".into(), "stand".into()]), None);
+    assert_eq!(held_arms(&["step forward with the left foot".into()]), None);
+}
+
+#[test]
 fn tracks_of_library_movements_are_named_by_them() {
     let jump = Library::builtin()
         .actions
