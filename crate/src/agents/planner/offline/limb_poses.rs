@@ -801,12 +801,15 @@ fn leg_pose(phrase: &[&str], at: usize, sides: &[Side]) -> Option<NamedPosture> 
         ]
     };
     let (what, constraints) = if behind {
-        ("out behind", straight(BodyPoint::Pelvis, Relation::Behind))
+        (
+            "lifted out behind",
+            straight(BodyPoint::Pelvis, Relation::Behind),
+        )
     } else if out {
-        ("out to the side", straight(hip, outward(side)))
+        ("lifted out to the side", straight(hip, outward(side)))
     } else if forward {
         (
-            "straight forward",
+            "lifted straight forward",
             straight(BodyPoint::Pelvis, Relation::InFrontOf),
         )
     } else if up || noun == "knee" {
@@ -905,7 +908,10 @@ mod tests {
         );
         assert_eq!(
             read("stretching the right leg out behind her"),
-            Some(("right leg out behind".into(), vec![BodyPart::RightLeg]))
+            Some((
+                "right leg lifted out behind".into(),
+                vec![BodyPart::RightLeg]
+            ))
         );
         assert_eq!(
             read("touches the right knee with the left hand").map(|p| p.0),
