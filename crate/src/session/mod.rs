@@ -390,10 +390,11 @@ impl Session {
 /// notes of the key poses that could not be met in full.
 ///
 /// Every motion the engine answers with is finished here: its rotations become those of its
-/// joints ([`with_joint_rotations`]), and it gets the one skeleton ([`with_reference_bones`]): the model predicts each joint on its own, so its bones
-/// stretch; fixed once in the features, the joints shown, the BVH, the JSON and both NPY
-/// exports all describe the same motion on the same bones. Here too its feet are planted
-/// ([`plant_feet`]), whatever made it.
+/// joints ([`with_joint_rotations`]), and it gets the one skeleton ([`with_reference_bones`]):
+/// the model predicts each joint on its own, so its bones stretch; fixed once in the
+/// features, the joints shown, the BVH, the JSON and both NPY exports all describe the same
+/// motion on the same bones. Here too its feet are planted ([`plant_feet`]), whatever made
+/// it.
 fn finished(
     features: &[FeatureFrame],
     fit: &SkeletonFit,

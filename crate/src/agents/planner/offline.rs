@@ -408,31 +408,13 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         // A phrase of a clause that made something, which left no trace in it, is named too
         // ("hops forward on the right foot, arms flapping like wings").
         if segments.len() > clause_start {
-            let mut made: Vec<String> = notes[notes_start..].to_vec();
-            for s in &segments[clause_start..] {
-                made.push(s.base.clone());
-                made.extend(
-                    BodyPart::ALL
-                        .iter()
-                        .filter_map(|p| s.parts.get(*p).map(str::to_string)),
-                );
-                if let Some(track) = &s.postures {
-                    made.extend(track.keys.iter().filter_map(|k| k.script.name.clone()));
-                }
-            }
-            made.extend(
+            let made = accounting::made_words(
+                &segments[clause_start..],
                 held.iter()
                     .filter(|(span, _)| span.start == clause_start)
                     .map(|(_, p)| p.name.clone()),
+                &notes[notes_start..],
             );
-            // A library movement or posture made is also said by its synonyms.
-            let library = crate::posture::library::Library::builtin();
-            let synonyms: Vec<String> = made
-                .iter()
-                .flat_map(|t| library.mentions(t))
-                .flat_map(|(_, named)| named.phrases())
-                .collect();
-            made.extend(synonyms);
             for phrase in accounting::phrases_without_trace(words, &made) {
                 notes.push(format!(
                     "\"{phrase}\" {NOT_PLACED}: the built-in planner made nothing of it"

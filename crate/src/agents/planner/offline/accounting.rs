@@ -293,6 +293,37 @@ fn stem(word: &str) -> &str {
     w.strip_suffix('e').filter(|r| r.len() >= 3).unwrap_or(w)
 }
 
+/// What the planner made of a clause, in words: the segments' base texts, part
+/// instructions and key-pose names, the names of the limb poses `held` over them, the
+/// clause's `notes`, and the library's other words for every movement or posture among them.
+pub(super) fn made_words(
+    made: &[Segment],
+    held: impl Iterator<Item = String>,
+    notes: &[String],
+) -> Vec<String> {
+    let mut out: Vec<String> = notes.to_vec();
+    for s in made {
+        out.push(s.base.clone());
+        out.extend(
+            BodyPart::ALL
+                .iter()
+                .filter_map(|p| s.parts.get(*p).map(str::to_string)),
+        );
+        if let Some(track) = &s.postures {
+            out.extend(track.keys.iter().filter_map(|k| k.script.name.clone()));
+        }
+    }
+    out.extend(held);
+    let library = crate::posture::library::Library::builtin();
+    let synonyms: Vec<String> = out
+        .iter()
+        .flat_map(|t| library.mentions(t))
+        .flat_map(|(_, named)| named.phrases())
+        .collect();
+    out.extend(synonyms);
+    out
+}
+
 /// The phrases riding on a clause that left no trace in what the planner made of it (`made`:
 /// the segments' base texts, part instructions and key-pose names, and the clause's notes):
 /// the clause cut at its boundaries and openers, and where a limb noun follows another one
