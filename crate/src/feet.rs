@@ -154,9 +154,9 @@ struct Contact {
 /// lands from one (a jump forward covered 1.4 m against the real clips' 1.0); moving the body
 /// instead of the foot keeps the legs as the model made them. Elsewhere (a walk's stance) the
 /// body's travel is the model's and the pins of step 3 hold the feet: carrying every stance
-/// back too made motions the evaluator scores as less real (FID 0.090 against 0.088 over
-/// 3 × 256 test motions, `coma eval`). In flight and between stances nothing firm holds the
-/// body and its travel is its own.
+/// back too made motions the text-motion evaluator scores as less real (with
+/// [`crate::features::with_joint_rotations`], FID 0.097 → 0.092, `EVAL.md`). In flight and
+/// between stances nothing firm holds the body and its travel is its own.
 fn glide_corrections(contact: &[Contact], poses: &[Pose], root_held: &[Range<usize>]) -> Vec<Vec3> {
     let (lowest, _) = lowest_points(poses);
     let ground = lowest.iter().copied().fold(f64::INFINITY, f64::min);

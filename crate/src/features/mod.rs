@@ -294,11 +294,11 @@ pub fn with_reference_bones_fitted(
 /// dataset computes them from its joints ([`skeleton::inverse_kinematics`]: each bone's
 /// shortest turn from its rest direction, relative to its parent, facing smoothed); every
 /// other column is kept. The motion model predicts rotations and positions apart, and its
-/// rotations drift from its positions; measured on the test split with the text-motion
-/// evaluator, the decoded motions with their joints' rotations are nearer the real ones
-/// (FID 0.081 against 0.085 over 3 × 256 motions, `coma eval`), and the engine's
-/// clean-up ([`crate::session::finish`]) starts from them. Motions of fewer than 2 rows
-/// come back unchanged.
+/// rotations drift from its positions. The engine's clean-up ([`crate::session::finish`])
+/// starts from these: with them (and the body carried back only around a jump, see
+/// [`crate::feet`]) the cleaned motions' FID on the test split went from 0.097 to 0.092
+/// (`EVAL.md`, `coma eval` as its first line says, at 14c1547 and 1711a32). Motions of fewer
+/// than 2 rows come back unchanged.
 pub fn with_joint_rotations(features: &[FeatureFrame]) -> Features {
     if features.len() < 2 {
         return features.to_vec();
