@@ -399,6 +399,15 @@ pub fn action_word(word: &str, next: &[&str], prev: &[&str]) -> Option<Action> {
         "wave" | "waves" | "waving" | "waved" | "greet" | "greets" | "greeting" => {
             Action::Wave(Side::Right)
         }
+        // "with arms raised", "his right hand lifted": where the arm is, not a raise (the
+        // limb's place holds it over the movement).
+        "raised" | "lifted"
+            if prev
+                .first()
+                .is_some_and(|w| matches!(*w, "arm" | "arms" | "hand" | "hands")) =>
+        {
+            return None
+        }
         // "lifts the right knee" raises a leg, which no gesture of the arms makes.
         "raise" | "raises" | "raising" | "raised" | "lift" | "lifts" | "lifting" | "lifted"
             if names_leg_first(next) =>

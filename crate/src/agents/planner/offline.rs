@@ -145,6 +145,21 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 ));
                 break 'clause;
             }
+            if let Some(across) = segments
+                .last()
+                .filter(|_| anaphora::goes_back(words))
+                .and_then(anaphora::back_across)
+            {
+                // "steps to the left, then back to the centre": the way back is to the right.
+                notes.push(format!(
+                    "\"{}\": back the way the movement before went, to the other side",
+                    words.join(" ")
+                ));
+                segments.push(across);
+                previous = None;
+                ends_standing = None;
+                break 'clause;
+            }
             let model = movements(words, previous, reader);
             let next_dataset_action = clauses
                 .get(k + 1)
@@ -184,6 +199,14 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 segments.push(standing_segment(text, Some(track)));
                 previous = None;
                 ends_standing = None;
+                // "sidesteps to the right with both arms crossed": what rides on the step.
+                // The foot a step names is the step's own ("steps to the left with the left
+                // foot").
+                let named: Vec<usize> = super::sided::leg_words(words).collect();
+                let made = &mut segments[clause_start..];
+                let poses = place_limb_phrases(words, &named, matcher.as_ref(), made, &mut notes);
+                let span = clause_start..segments.len();
+                held.extend(poses.into_iter().map(|p| (span.clone(), p)));
                 break 'clause;
             }
             if let Some(held) = segments

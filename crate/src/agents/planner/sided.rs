@@ -175,17 +175,42 @@ pub fn on_one_foot(track: &mut PostureTrack, stands_on: Side) {
 const STEP_METRES: f64 = 0.35;
 
 /// One step of the foot a clause names ("steps forward with the left foot", "steps back with
-/// the right foot"): the body carried [`STEP_METRES`] that way and standing with that foot
-/// ahead (or behind), both feet on the ground. `None` unless the clause steps with a foot it
-/// names, forward or back.
+/// the right foot"), or one step to a side ("steps to the left", "sidesteps to the right",
+/// "steps to the left with the left foot"): the body carried [`STEP_METRES`] that way and
+/// standing again with both feet on the ground, the stepping foot ahead (or behind) after a
+/// step forward or back. `None` unless the clause is such a step: forward or back with a foot
+/// it names, or to one side.
 pub fn single_step(words: &[&str]) -> Option<PostureTrack> {
-    let steps = words
+    let sidestep = words
         .iter()
-        .any(|w| matches!(*w, "step" | "steps" | "stepping"));
-    let (side, rests, _) = named_leg(words)?;
+        .any(|w| matches!(*w, "sidestep" | "sidesteps" | "sidestepping"));
+    let steps = sidestep
+        || words
+            .iter()
+            .any(|w| matches!(*w, "step" | "steps" | "stepping"));
     let has = |list: &[&str]| words.iter().any(|w| list.contains(w));
     let forward = has(&["forward", "forwards", "ahead", "front"]);
     let back = has(&["back", "backward", "backwards", "behind"]);
+    // "to the left", "to his right": the way, unless the side word names a limb.
+    let way = words.iter().enumerate().find_map(|(i, w)| {
+        let side = Side::of_word(w)?;
+        let limb_follows = words
+            .get(i + 1)
+            .is_some_and(|n| matches!(*n, "leg" | "foot" | "knee" | "arm" | "hand"));
+        let after_to = words[..i]
+            .iter()
+            .rev()
+            .take(2)
+            .any(|w| matches!(*w, "to" | "toward" | "towards"));
+        (after_to && !limb_follows).then_some(side)
+    });
+    if let Some(way) = way.filter(|_| steps && !forward && !back) {
+        if !sidestep && !words.iter().any(|w| matches!(*w, "step" | "steps")) {
+            return None;
+        }
+        return side_step(way);
+    }
+    let (side, rests, _) = named_leg(words)?;
     if !steps || rests || forward == back {
         return None;
     }
@@ -196,41 +221,64 @@ pub fn single_step(words: &[&str]) -> Option<PostureTrack> {
         (Side::Right, false) => (BodyPoint::RightFoot, "back", -1.0),
     };
     let name = format!("step {way} with the {} foot", side.name());
+    let relation = if forward {
+        Relation::InFrontOf
+    } else {
+        Relation::Behind
+    };
+    let mut constraints = standing_on_both_feet();
+    constraints.push(Constraint::Relation {
+        a: foot,
+        b: BodyPoint::Pelvis,
+        is: relation,
+    });
+    stepped(name, constraints, [0.0, sign * STEP_METRES])
+}
+
+/// One step to `way`: the body carried [`STEP_METRES`] to that side, standing on both feet.
+fn side_step(way: Side) -> Option<PostureTrack> {
+    let left = match way {
+        Side::Left => STEP_METRES,
+        Side::Right => -STEP_METRES,
+    };
+    let name = format!("side step to the {}", way.name());
+    stepped(name, standing_on_both_feet(), [left, 0.0])
+}
+
+/// A standing pose with both feet on the ground, shoulder width apart.
+fn standing_on_both_feet() -> Vec<Constraint> {
+    vec![
+        Constraint::Level {
+            is: PelvisLevel::Standing,
+        },
+        Constraint::Contact {
+            point: Support::LeftFoot,
+            on_ground: true,
+        },
+        Constraint::Contact {
+            point: Support::RightFoot,
+            on_ground: true,
+        },
+        Constraint::Distance {
+            a: BodyPoint::LeftFoot,
+            b: BodyPoint::RightFoot,
+            is: Distance::ShoulderWidth,
+        },
+    ]
+}
+
+/// A whole-body key pose named `name`, held half a second, reached by travelling `travel`
+/// (`[left, forward]` metres).
+fn stepped(name: String, constraints: Vec<Constraint>, travel: [f64; 2]) -> Option<PostureTrack> {
     let script = PostureScript {
         name: Some(name),
         hold: 0.5,
-        constraints: vec![
-            Constraint::Level {
-                is: PelvisLevel::Standing,
-            },
-            Constraint::Contact {
-                point: Support::LeftFoot,
-                on_ground: true,
-            },
-            Constraint::Contact {
-                point: Support::RightFoot,
-                on_ground: true,
-            },
-            Constraint::Relation {
-                a: foot,
-                b: BodyPoint::Pelvis,
-                is: if forward {
-                    Relation::InFrontOf
-                } else {
-                    Relation::Behind
-                },
-            },
-            Constraint::Distance {
-                a: BodyPoint::LeftFoot,
-                b: BodyPoint::RightFoot,
-                is: Distance::ShoulderWidth,
-            },
-        ],
+        constraints,
     }
     .check()
     .ok()?;
     let mut track = PostureTrack::holding(crate::skeleton::BodyPart::ALL.to_vec(), script);
-    track.keys[0].travel = [0.0, sign * STEP_METRES];
+    track.keys[0].travel = travel;
     Some(track)
 }
 

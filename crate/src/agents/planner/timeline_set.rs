@@ -518,7 +518,13 @@ pub fn plan_elements(plan: &Plan) -> Vec<Element> {
             }
             let text = library_movement(&names).unwrap_or_else(|| names.join(", "));
             let aliases = library_words(&text, &names);
-            let text = format!("{text}{}", way(track));
+            // The way a track goes, unless its names say it already ("side step to the left").
+            let way = way(track);
+            let text = if way.is_empty() || text.ends_with(way.trim_start_matches(", ")) {
+                text
+            } else {
+                format!("{text}{way}")
+            };
             let mut parts = track.parts.clone();
             parts.sort();
             out.push(Element {

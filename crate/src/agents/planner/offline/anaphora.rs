@@ -248,6 +248,63 @@ pub(super) fn repeated_poses(poses: &[NamedPosture], again: Again) -> Option<Vec
     )
 }
 
+/// Words of a clause that goes back the way it came and says nothing more ("back to the
+/// centre", "jumps back to where they started", "steps back to the middle").
+const GOING_BACK: &[&str] = &[
+    "back", "then", "and", "to", "the", "a", "his", "her", "their", "where", "he", "she", "they",
+    "it", "someone", "person", "centre", "center", "middle", "start", "started", "began", "place",
+    "position", "original", "spot", "again", "step", "steps", "walk", "walks", "jump", "jumps",
+    "hop", "hops", "move", "moves", "go", "goes", "come", "comes", "shuffle", "shuffles", "slide",
+    "slides",
+];
+
+/// Whether a clause only goes back the way the body came ("then back to the centre"); see
+/// [`back_across`].
+pub(super) fn goes_back(words: &[&str]) -> bool {
+    words.contains(&"back")
+        && words
+            .iter()
+            .all(|w| GOING_BACK.contains(w) || super::super::lexicon::is_subject_noun(w))
+}
+
+/// The side a segment carries the body to, by its key poses' travel or its words ("walks to
+/// the left", "side step to the right"); `None` when it goes no way sideways.
+fn lateral_way(segment: &Segment) -> Option<Side> {
+    if let Some(track) = &segment.postures {
+        let left: f64 = track.keys.iter().map(|k| k.travel[0]).sum();
+        if left.abs() > 1e-6 {
+            return Some(if left > 0.0 { Side::Left } else { Side::Right });
+        }
+    }
+    let said = |side: &str| {
+        segment.base.contains(&format!("to the {side}"))
+            || segment.text.contains(&format!("to the {side}"))
+    };
+    match (said("left"), said("right")) {
+        (true, false) => Some(Side::Left),
+        (false, true) => Some(Side::Right),
+        _ => None,
+    }
+}
+
+/// The clause "back" after a movement to one side: the same movement to the other side, so
+/// the body ends where it started ("steps to the left, then back to the centre": a step to
+/// the right). `None` when the movement before went no way sideways.
+pub(super) fn back_across(before: &Segment) -> Option<Segment> {
+    lateral_way(before)?;
+    let mut back = mirrored(before);
+    if let Some(track) = &mut back.postures {
+        for key in &mut track.keys {
+            key.script.name = key
+                .script
+                .name
+                .as_deref()
+                .map(|n| n.replacen("side step to", "step back to", 1));
+        }
+    }
+    Some(back)
+}
+
 /// A segment with its left and right swapped: the words, the part instructions and the key
 /// poses.
 fn mirrored(segment: &Segment) -> Segment {

@@ -12,7 +12,7 @@
 
 use crate::posecodes::Support;
 use crate::posecodes::{Bend, BodyPoint, Distance, Limb, Orientation, PelvisLevel, Relation};
-use crate::posture::library::NamedPosture;
+use crate::posture::library::{Library, Named, NamedPosture};
 use crate::posture::script::{Constraint, Hinge, PostureScript};
 use crate::skeleton::{BodyPart, Side};
 
@@ -221,6 +221,21 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
     if let Some(pose) = holding_pose(phrase) {
         return Some(pose);
     }
+    // "both arms crossed over the chest": a posture of both arms the library names is that
+    // posture, not a point the words name (the hands on the chest); a way the words say
+    // ("arms out to the sides") is read as it is.
+    let said_way = arm_place(phrase).is_some_and(|p| !matches!(p, Place::On(_)));
+    if let Some(pose) = (!said_way)
+        .then(|| Library::builtin().mentions(&text))
+        .unwrap_or_default()
+        .into_iter()
+        .find_map(|(_, named)| match named {
+            Named::Posture(p) if is_arms_posture(p) => Some(p.clone()),
+            _ => None,
+        })
+    {
+        return Some(pose);
+    }
     let nouns: Vec<(usize, Kind, bool)> = phrase
         .iter()
         .enumerate()
@@ -256,6 +271,15 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
         Kind::Arm => arm_pose(scope, &sides),
         Kind::Leg => leg_pose(scope, at, &sides),
     }
+}
+
+/// Whether a library posture holds both arms and nothing else ("arms crossed", "hands on
+/// hips").
+fn is_arms_posture(p: &NamedPosture) -> bool {
+    p.parts.len() == 2
+        && p.parts
+            .iter()
+            .all(|part| matches!(part, BodyPart::LeftArm | BodyPart::RightArm))
 }
 
 /// Verbs of a hand that holds a thing.

@@ -998,13 +998,13 @@ fn a_clause_made_as_other_words_is_named_in_a_note() {
             .chain(std::iter::once(0.1))
             .collect()
     };
-    let steps = plan("A dancer steps to the left.", Some(&verb));
+    let steps = plan("A dancer wanders to the left.", Some(&verb));
     assert_eq!(steps.segments[0].base, "a person walks to the left");
     assert!(
         steps
             .notes
             .iter()
-            .any(|n| n.contains("\"a dancer steps to the left\"") && n.contains(MADE_AS)),
+            .any(|n| n.contains("\"a dancer wanders to the left\"") && n.contains(MADE_AS)),
         "{:?}",
         steps.notes
     );
@@ -1172,11 +1172,46 @@ fn ending_leaving_and_sidestepping_are_movements_of_their_own() {
         "Someone sidesteps to the right with both arms crossed over the chest.",
         None,
     );
+    // One step to the right (key poses carrying the body 0.35 m), the arms crossed over it.
     assert_eq!(
-        side.segments[0].base, "a person walks to the right",
+        key_names(&side.segments[0]),
+        ["side step to the right"],
         "{side:#?}"
     );
-    assert_eq!(key_names(&side.segments[0]), ["arms crossed"]);
+    let travel = side.segments[0].postures.as_ref().expect("keys").keys[0].travel;
+    assert!(travel[0] < -0.3 && travel[1] == 0.0, "{travel:?}");
+    assert_eq!(side.clips.len(), 1, "{side:#?}");
+    assert_eq!(side.clips[0].text, "arms crossed");
+    // "back" after a step to a side is a step to the other side; the foot a step names is
+    // its own.
+    let back = plan(
+        "A dancer steps to the left with the left foot, then back to the centre.",
+        None,
+    );
+    assert_eq!(
+        back.segments.iter().map(key_names).collect::<Vec<_>>(),
+        [["side step to the left"], ["step back to the right"]],
+        "{back:#?}"
+    );
+    assert!(
+        !back.notes.iter().any(|n| is_unplanned_note(n)),
+        "{:?}",
+        back.notes
+    );
+    let jumps = plan(
+        "A person jumps to the left, then jumps back to where they started.",
+        None,
+    );
+    let way = |s: &Segment| {
+        s.postures
+            .as_ref()
+            .map(|t| t.keys.iter().map(|k| k.travel[0]).sum::<f64>())
+    };
+    let ways: Vec<f64> = jumps.segments.iter().filter_map(way).collect();
+    assert!(
+        ways.len() == 2 && ways[0] > 0.0 && ways[1] < 0.0,
+        "{jumps:#?}"
+    );
     // "puts it back down" after a raise lowers the arm, after a pick-up puts the thing down.
     let lowered = plan(
         "A man raises his left hand to wave, and after a moment puts it back down.",
