@@ -225,15 +225,15 @@ pub(super) fn limb_pose(phrase: &[&str]) -> Option<NamedPosture> {
     // posture, not a point the words name (the hands on the chest); a way the words say
     // ("arms out to the sides") is read as it is.
     let said_way = arm_place(phrase).is_some_and(|p| !matches!(p, Place::On(_)));
-    if let Some(pose) = (!said_way)
-        .then(|| Library::builtin().mentions(&text))
-        .unwrap_or_default()
-        .into_iter()
-        .find_map(|(_, named)| match named {
-            Named::Posture(p) if is_arms_posture(p) => Some(p.clone()),
-            _ => None,
-        })
-    {
+    let mentions = if said_way {
+        Vec::new()
+    } else {
+        Library::builtin().mentions(&text)
+    };
+    if let Some(pose) = mentions.into_iter().find_map(|(_, named)| match named {
+        Named::Posture(p) if is_arms_posture(p) => Some(p.clone()),
+        _ => None,
+    }) {
         return Some(pose);
     }
     let nouns: Vec<(usize, Kind, bool)> = phrase
