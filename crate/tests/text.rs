@@ -495,18 +495,23 @@ fn the_planner_places_movements_by_meaning_and_keeps_sides_and_directions() {
         reaches.segments.iter().all(|s| !s.text.contains("left")),
         "{reaches:#?}"
     );
-    // A clause that names no side gets no substitute with a side of its own: "back to the
-    // centre" after a step to the right is no turn to the right.
+    // "back to the centre" after a step to the right is a step back to the left (where the
+    // body came from), not a substitute of its own.
     let centre = offline::plan(
         "A dancer steps to the left, then steps to the right, then back to the centre.",
         Some(&embed),
     );
+    let back = centre.segments.get(2).and_then(|s| s.postures.as_ref());
+    let names: Vec<Option<&str>> = back
+        .map(|t| t.keys.iter().map(|k| k.script.name.as_deref()).collect())
+        .unwrap_or_default();
+    assert_eq!(names, [Some("step back to the left")], "{centre:#?}");
     assert!(
-        centre
-            .segments
-            .iter()
-            .skip(2)
-            .all(|s| !s.text.contains("left") && !s.text.contains("right")),
+        back.is_some_and(|t| t.keys[0].travel[0] > 0.3),
+        "{centre:#?}"
+    );
+    assert!(
+        !centre.notes.iter().any(|n| offline::is_unplanned_note(n)),
         "{centre:#?}"
     );
 }

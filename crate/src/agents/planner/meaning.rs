@@ -12,18 +12,25 @@
 //! stand, walk and run, which MiniLM puts close together: "walks forward" and "runs forward"
 //! score 0.62, above many paraphrases).
 //!
+//! One rule comes before the encoder: the same walk or the same run going the same way, saying
+//! nothing more, is the same movement ([`same_gait`]: "walks away" and "a person walks
+//! forward" score 0.475, "jogs along the beach" and "a person runs forward" 0.357, below
+//! paraphrases of other movements).
+//!
 //! The threshold was calibrated on 110 hand-labelled pairs
 //! (`crate/tests/fixtures/timeline_similarity_pairs.json`: a clause as a prompt says it, a
 //! text as a plan says it, same movement or not), written before the scorer was run on the
-//! set, with [`calibrate`]: the accuracy of each threshold, averaged over ±0.02 so that no
-//! single pair decides, is highest (90.3 %) from 0.490 to 0.495, and the threshold is the
-//! middle of that range. At 0.492, 99 of the 110 pairs are labelled right; three different
-//! movements pass (a wave and a raise of the hand, throwing a ball and kicking one, hands
-//! behind the back and behind the head) and eight paraphrases are missed ("sprints ahead" and
-//! "dashes forward at full speed", "gets back on his feet" and "stands up", jumping jacks
-//! against the names of their key poses, …), so the scorer errs towards calling a clause
-//! lost rather than placing it on a different movement. `crate/tests/text.rs` recomputes the
-//! calibration with the shipped encoder and fails if the constant leaves that range.
+//! set, with [`calibrate`], with the rule above inside the match: the accuracy of each
+//! threshold, averaged over ±0.02 so that no single pair decides, is highest (90.4 %) from
+//! 0.495 to 0.503, and the threshold is the middle of that range (it was 0.492, from 0.490 to
+//! 0.495, before the rule). At 0.499, 99 of the 110 pairs are labelled right; three
+//! different movements pass (a wave and a raise of the hand, throwing a ball and kicking one,
+//! hands behind the back and behind the head) and eight paraphrases are missed ("sprints
+//! ahead" and "dashes forward at full speed", "gets back on his feet" and "stands up",
+//! jumping jacks against the names of their key poses, a walk on a path against a plain walk,
+//! …), so the scorer errs towards calling a clause lost rather than placing it on a different
+//! movement. `crate/tests/text.rs` recomputes the calibration with the shipped encoder and
+//! fails if the constant leaves that range.
 //!
 use super::offline::Embedder;
 use serde::{Deserialize, Serialize};
@@ -33,7 +40,7 @@ use std::path::Path;
 
 /// Lowest similarity at which a clause and a plan text are the same movement (see the module
 /// documentation for how it was calibrated).
-pub const SAME_MOVEMENT_MIN_SIMILARITY: f32 = 0.492;
+pub const SAME_MOVEMENT_MIN_SIMILARITY: f32 = 0.499;
 
 /// Words of opposite directions, and the two gaits: a clause and a text that each name one
 /// side of a pair and not the other are not the same movement, however close MiniLM puts
@@ -68,7 +75,17 @@ pub(crate) const OPPOSITES: [(&[&str], &[&str]); 4] = [
     ),
     // Gaits: MiniLM puts "walks forward" and "runs forward" closer than many paraphrases.
     (
-        &["walk", "walks", "walking", "stroll", "strolls", "strolling"],
+        &[
+            "walk",
+            "walks",
+            "walking",
+            "stroll",
+            "strolls",
+            "strolling",
+            "march",
+            "marches",
+            "marching",
+        ],
         &[
             "run",
             "runs",
@@ -130,12 +147,15 @@ fn gait_way(words: &[String]) -> Option<u8> {
 }
 
 /// Words that add nothing to which walk or run a text means: the person, articles, going on
-/// ("keeps walking"), manner of pace, and a place it goes to or along ("to the door", "along
-/// the beach"; everything after such a preposition is the place, unless it names a limb, a
-/// way or a shape, which say more).
+/// ("keeps walking"), manner ("very slowly", "like an elderly person"), and a place it goes to or along ("to the door", "along
+/// the beach"; everything after such a preposition is the place, unless it names a limb, goes
+/// back or names a shape). A path ("in a circle") says more: the rule stays out of the way
+/// of a walk on a path and a plain walk of the same prompt, which the encoder tells apart.
 fn says_only_the_gait(words: &[String]) -> bool {
+    // After these, the rest is a place ("to the door") or a manner ("like an elderly
+    // person").
     const PLACE: &[&str] = &[
-        "to", "toward", "towards", "along", "across", "into", "through",
+        "to", "toward", "towards", "along", "across", "into", "through", "like",
     ];
     const SAYS_MORE: &[&str] = &[
         "back", "around", "round", "circle", "arc", "zigzag", "curve", "arm", "arms", "hand",
@@ -182,6 +202,7 @@ fn says_only_the_gait(words: &[String]) -> bool {
                     | "left"
                     | "right"
                     | "sideways"
+                    | "very"
                     | "slowly"
                     | "quickly"
                     | "calmly"
@@ -437,7 +458,7 @@ mod tests {
             ("walks backward", "a person walks forward"),
             ("walks to the left", "a person walks forward"),
             ("walks to the door and then back", "a person walks forward"),
-            ("walks in a circle", "a person walks forward"),
+            ("walks in a circle", "a person runs forward"),
             (
                 "walks forward waving the left hand",
                 "a person walks forward",

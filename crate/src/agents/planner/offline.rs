@@ -129,6 +129,7 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     // Limb poses read from the words, held over a clause's segments (their indices).
     let mut held: Vec<(std::ops::Range<usize>, NamedPosture)> = Vec::new();
     for (k, words) in clauses.iter().enumerate() {
+        let words = with_subject_whole(words, readers[k]);
         let words = words.as_slice();
         let reader = readers[k];
         let clause_start = segments.len();
@@ -265,6 +266,31 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 ends_standing = None;
                 break 'clause;
             }
+            // "lifts the right knee, holds it": the places the clause before reached, kept
+            // over a clip of their own; "raises both hands, holds them up": the arms up.
+            if let Some(poses) = model
+                .is_none()
+                .then(|| anaphora::holds_back(words))
+                .filter(|holds| *holds)
+                .and_then(|_| kept_places(&held, clause_start, segments.last()))
+            {
+                let names: Vec<&str> = poses.iter().map(|p| p.name.as_str()).collect();
+                let text = format!("a person holds still, {}", names.join(", "));
+                let body = segments
+                    .last()
+                    .filter(|last| last.postures.as_ref().is_some_and(|t| t.whole_body()))
+                    .and_then(|last| postures::hold_segment(words, last))
+                    .unwrap_or_else(|| standing_segment(text, None));
+                segments.push(body);
+                let span = clause_start..segments.len();
+                held.extend(poses.into_iter().map(|mut p| {
+                    p.name = anaphora::held_name(&p.name);
+                    p.script.name = Some(p.name.clone());
+                    (span.clone(), p)
+                }));
+                previous = None;
+                break 'clause;
+            }
             if let (None, Some(stay)) = (&model, postures::stay(words)) {
                 let held = match (stay, segments.last()) {
                     (postures::Stay::Hold, Some(last)) => postures::hold_segment(words, last),
@@ -319,13 +345,21 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 .then(|| anaphora::again(words))
                 .flatten()
                 .and_then(|a| {
-                    let last = segments.iter().rev().find(|s| !anaphora::is_lowering(s))?;
-                    anaphora::repeated(last, a)
+                    let last = segments.iter().rposition(|s| !anaphora::is_lowering(s))?;
+                    let one = anaphora::repeated(&segments[last], a)?;
+                    // "sits down, then gets up and does the same thing again": getting up
+                    // ends what is done again, so the movement before it comes back too.
+                    Some(match last.checked_sub(1) {
+                        Some(before) if a == anaphora::Again::Same && gets_up(&segments[last]) => {
+                            vec![segments[before].clone(), one]
+                        }
+                        _ => vec![one],
+                    })
                 })
             {
                 // "waves with the left hand, then with the right"; "repeats it twice more".
                 for _ in 0..lexicon::repetitions(words) {
-                    segments.push(once_more.clone());
+                    segments.extend(once_more.iter().cloned());
                 }
                 break 'clause;
             }
@@ -338,8 +372,15 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                     .any(|w| matches!(w, "raise" | "raises" | "lift" | "lifts"));
                 said_raise && !anaphora::raised_arms(s).is_empty()
             });
-            if let Some(lowered) = (model.is_none() || after_raise)
-                .then(|| lowered_back(words, segments.last()))
+            // "lifts the right knee, holds it, and then puts it down": the limbs held just
+            // before.
+            let held_before: Vec<BodyPart> = held
+                .iter()
+                .filter(|(span, _)| span.end == clause_start && !span.is_empty())
+                .flat_map(|(_, p)| p.parts.clone())
+                .collect();
+            if let Some(lowered) = (model.is_none() || after_raise || !held_before.is_empty())
+                .then(|| lowered_back(words, segments.last(), &held_before))
                 .flatten()
             {
                 segments.push(lowered);
@@ -496,10 +537,76 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     }
 }
 
+/// A clause with the words that name the person read as one name: a word between the
+/// article and the noun for the person that would read as a movement ("a **basketball**
+/// player") says who, not what the body does, and is dropped. Other words there ("an **old**
+/// man") stay: they are the person's style.
+fn with_subject_whole<'a>(words: &[&'a str], reader: Reader) -> Vec<&'a str> {
+    let Some(article) = words
+        .iter()
+        .position(|w| matches!(*w, "a" | "an" | "the"))
+        .filter(|&i| words[..i].iter().all(|w| lexicon::is_subject_word(w)))
+    else {
+        return words.to_vec();
+    };
+    let Some(noun) =
+        (article + 1..(article + 4).min(words.len())).find(|&i| lexicon::is_subject_noun(words[i]))
+    else {
+        return words.to_vec();
+    };
+    words
+        .iter()
+        .enumerate()
+        .filter(|&(i, w)| {
+            !((article + 1..noun).contains(&i) && movements(&[*w], None, reader).is_some())
+        })
+        .map(|(_, w)| *w)
+        .collect()
+}
+
+/// Whether a segment gets the body up to standing (the library's "stand up").
+fn gets_up(segment: &Segment) -> bool {
+    segment.postures.as_ref().is_some_and(|t| {
+        t.keys
+            .iter()
+            .any(|k| k.script.name.as_deref() == Some("stand up"))
+    }) || postures::stands_up(&segment.text.split(' ').collect::<Vec<_>>())
+}
+
+/// The limb places a clause that holds what came before keeps: those held over the clause
+/// just before (`held`, ending at `clause_start`), else the arms the segment before raised,
+/// up; `None` when there are none.
+fn kept_places(
+    held: &[(std::ops::Range<usize>, NamedPosture)],
+    clause_start: usize,
+    before: Option<&Segment>,
+) -> Option<Vec<NamedPosture>> {
+    let kept: Vec<NamedPosture> = held
+        .iter()
+        .filter(|(span, _)| span.end == clause_start && !span.is_empty())
+        .map(|(_, p)| p.clone())
+        .collect();
+    if !kept.is_empty() {
+        return Some(kept);
+    }
+    let which = match anaphora::raised_arms(before?).as_slice() {
+        [BodyPart::LeftArm] => "left arm up",
+        [BodyPart::RightArm] => "right arm up",
+        [] => return None,
+        _ => "both arms up",
+    };
+    let words: Vec<&str> = which.split(' ').collect();
+    limb_poses::limb_pose(&words).map(|p| vec![p])
+}
+
 /// The segment of a clause that lowers the arms the segment before raised ("raises her right
 /// arm and then lowers it"): the arms go down to the library's standing posture while the
 /// body stands; `None` when the clause is no such thing or nothing before was raised.
-fn lowered_back(words: &[&str], before: Option<&Segment>) -> Option<Segment> {
+fn lowered_back(
+    words: &[&str],
+    before: Option<&Segment>,
+    held_before: &[BodyPart],
+) -> Option<Segment> {
     if !anaphora::lowers_back(words) {
         return None;
     }
@@ -509,17 +616,28 @@ fn lowered_back(words: &[&str], before: Option<&Segment>) -> Option<Segment> {
         // "waves with the left hand, lowers it": the arm the movement before used.
         arms = anaphora::moved_arms(before);
     }
+    let is_arm = |p: &&BodyPart| matches!(p, BodyPart::LeftArm | BodyPart::RightArm);
+    if arms.is_empty() {
+        // "raises both hands, holds them up, then lets them drop": the arms held just before.
+        arms = held_before.iter().filter(is_arm).copied().collect();
+    }
     let stand = Library::builtin().get("stand")?;
-    let which = match arms.as_slice() {
-        [BodyPart::LeftArm] => "the left arm",
-        [BodyPart::RightArm] => "the right arm",
-        [] => return None,
-        _ => "both arms",
+    let legs: Vec<BodyPart> = held_before.iter().filter(|p| !is_arm(p)).copied().collect();
+    let (parts, which, name) = match (arms.as_slice(), legs.as_slice()) {
+        ([BodyPart::LeftArm], _) => (arms, "lowers the left arm", anaphora::ARMS_DOWN),
+        ([BodyPart::RightArm], _) => (arms, "lowers the right arm", anaphora::ARMS_DOWN),
+        ([], []) => return None,
+        // "lifts the right knee, holds it, then puts it down": the foot back on the ground.
+        ([], [BodyPart::LeftLeg]) => (legs, "puts the left foot down", "left foot down"),
+        ([], [BodyPart::RightLeg]) => (legs, "puts the right foot down", "right foot down"),
+        ([], _) => (legs, "puts both feet down", "feet down"),
+        _ => (arms, "lowers both arms", anaphora::ARMS_DOWN),
     };
     let mut script = stand.script.clone();
-    script.name = Some(anaphora::ARMS_DOWN.into());
+    script.name = Some(name.into());
+    let arms = parts;
     Some(Segment {
-        text: format!("a person lowers {which}"),
+        text: format!("a person {which}"),
         seconds: 2.0,
         base: "a person stands still".into(),
         parts: PartEdits::default(),

@@ -248,6 +248,38 @@ pub(super) fn repeated_poses(poses: &[NamedPosture], again: Again) -> Option<Vec
     )
 }
 
+/// Words a clause that only keeps the place the clause before reached may hold besides its
+/// verb and what it points at ("holds it there for a moment", "keeps them up").
+const HOLDING_ON: &[&str] = &[
+    "it", "them", "there", "up", "in", "place", "the", "air", "for", "a", "an", "moment", "while",
+    "few", "seconds", "second", "briefly", "then", "and", "still", "steady", "that", "position",
+    "pose", "he", "she", "they", "someone", "person", "again", "long", "as",
+];
+
+/// Whether a clause only keeps where the clause before put a limb ("holds it", "holds it
+/// there", "holds them up for a moment", "keeps it up"): a holding verb, a word pointing
+/// back, and nothing else that moves.
+pub(super) fn holds_back(words: &[&str]) -> bool {
+    let verb = words
+        .iter()
+        .any(|w| matches!(*w, "hold" | "holds" | "holding" | "keep" | "keeps"));
+    let points = words
+        .iter()
+        .any(|w| matches!(*w, "it" | "them" | "there" | "pose" | "position"));
+    verb && points
+        && words.iter().all(|w| {
+            matches!(*w, "hold" | "holds" | "holding" | "keep" | "keeps")
+                || HOLDING_ON.contains(w)
+                || super::super::lexicon::is_subject_noun(w)
+        })
+}
+
+/// The name of a limb's place kept by a clause of its own ("right leg lifted, knee up,
+/// held"): the place goes on, as a clip of its own.
+pub(super) fn held_name(name: &str) -> String {
+    format!("{name}, held")
+}
+
 /// Words of a clause that goes back the way it came and says nothing more ("back to the
 /// centre", "jumps back to where they started", "steps back to the middle").
 const GOING_BACK: &[&str] = &[

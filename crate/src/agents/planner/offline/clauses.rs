@@ -93,12 +93,16 @@ fn is_verb(word: &str, known: Repertoire) -> bool {
 /// her right shoe", "…, grabs the rail"): a clause of its own. After "and" the same words
 /// more often finish the clause before ("dribbles and shoots a basketball").
 fn verb_with_object(words: &[String]) -> bool {
+    let determiner = |w: &str| matches!(w, "his" | "her" | "their" | "its" | "the" | "a" | "an");
     match words {
-        [verb, next, ..] => {
+        [verb, next, ..] if determiner(next) => verb_form(verb),
+        // "…, drinks from the cup", "…, leans on the wall".
+        [verb, preposition, next, ..] => {
             matches!(
-                next.as_str(),
-                "his" | "her" | "their" | "its" | "the" | "a" | "an"
-            ) && verb_form(verb)
+                preposition.as_str(),
+                "from" | "at" | "on" | "with" | "into" | "onto" | "through" | "over"
+            ) && determiner(next)
+                && verb_form(verb)
         }
         _ => false,
     }

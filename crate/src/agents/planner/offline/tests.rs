@@ -1281,3 +1281,82 @@ fn ending_leaving_and_sidestepping_are_movements_of_their_own() {
         "{dive:#?}"
     );
 }
+
+#[test]
+fn holding_and_putting_down_point_back_at_the_limbs_placed_before() {
+    // "holds it" keeps the place the clause before reached, as a clip of its own; "puts it
+    // down" then puts that foot down.
+    let knee = plan(
+        "A person lifts the right knee up high, holds it, and then puts it down.",
+        None,
+    );
+    let texts: Vec<(&str, Vec<BodyPart>)> = knee
+        .clips
+        .iter()
+        .map(|c| (c.text.as_str(), c.parts.clone()))
+        .collect();
+    assert_eq!(
+        texts,
+        [
+            ("right leg lifted, knee up", vec![BodyPart::RightLeg]),
+            ("right leg lifted, knee up, held", vec![BodyPart::RightLeg])
+        ],
+        "{knee:#?}"
+    );
+    assert!(knee.clips[1].start >= knee.clips[0].end - 1e-9);
+    let down = knee.segments.last().and_then(|s| s.postures.as_ref());
+    assert_eq!(
+        down.map(|t| t.parts.clone()),
+        Some(vec![BodyPart::RightLeg])
+    );
+    assert!(
+        !knee.notes.iter().any(|n| is_unplanned_note(n)),
+        "{:?}",
+        knee.notes
+    );
+    // After a raise, "holds them up" keeps the arms up and "lets them drop" lowers them.
+    let hands = plan(
+        "A woman raises both hands, holds them up for a moment, then lets them drop.",
+        None,
+    );
+    assert_eq!(hands.segments.len(), 3, "{hands:#?}");
+    assert_eq!(hands.clips.len(), 1, "{hands:#?}");
+    assert_eq!(hands.clips[0].text, "both arms up, held");
+    assert_eq!(hands.segments[2].text, "a person lowers both arms");
+}
+
+#[test]
+fn doing_the_same_again_after_getting_up_repeats_what_came_before_it() {
+    let again = plan(
+        "Someone sits down on the floor, then gets up and does the same thing again.",
+        None,
+    );
+    let texts: Vec<&str> = again.segments.iter().map(|s| s.text.as_str()).collect();
+    assert_eq!(
+        texts,
+        [
+            "a person sits down on the floor",
+            "a person gets up",
+            "a person sits down on the floor",
+            "a person gets up"
+        ],
+        "{again:#?}"
+    );
+}
+
+#[test]
+fn a_verb_with_a_preposition_and_its_object_starts_a_clause() {
+    let drinks = plan(
+        "A man sits down on a chair, drinks from the cup, and stands up.",
+        None,
+    );
+    assert_eq!(drinks.segments.len(), 2, "{drinks:#?}");
+    assert!(
+        drinks
+            .notes
+            .iter()
+            .any(|n| n.starts_with("\"drinks from the cup\"")),
+        "{:?}",
+        drinks.notes
+    );
+}
