@@ -99,6 +99,9 @@ pub(crate) const OPPOSITES: [(&[&str], &[&str]); 4] = [
             "dash",
             "dashes",
             "dashing",
+            "hurry",
+            "hurries",
+            "hurrying",
         ],
     ),
 ];
@@ -128,12 +131,13 @@ fn gait(words: &[String]) -> Option<usize> {
 }
 
 /// Words that say which way a walk or a run goes: forward (also when no way is said: a walk
-/// goes forward), backward, or sideways (left and right are checked on their own).
+/// goes forward, and so does one that goes "away" or "off"), backward, or sideways (left and
+/// right are checked on their own).
 fn gait_way(words: &[String]) -> Option<u8> {
     let mut way = None;
     for w in words {
         let this = match w.as_str() {
-            "forward" | "forwards" | "ahead" | "away" | "onward" | "onwards" | "straight" => 0,
+            "forward" | "forwards" | "ahead" | "onward" | "onwards" | "straight" => 0,
             "backward" | "backwards" => 1,
             "left" | "right" | "sideways" => 2,
             _ => continue,
@@ -155,7 +159,7 @@ fn says_only_the_gait(words: &[String]) -> bool {
     // After these, the rest is a place ("to the door") or a manner ("like an elderly
     // person").
     const PLACE: &[&str] = &[
-        "to", "toward", "towards", "along", "across", "into", "through", "like",
+        "to", "toward", "towards", "along", "across", "into", "through", "like", "at", "down",
     ];
     const SAYS_MORE: &[&str] = &[
         "back", "around", "round", "circle", "arc", "zigzag", "curve", "arm", "arms", "hand",
@@ -202,6 +206,9 @@ fn says_only_the_gait(words: &[String]) -> bool {
                     | "left"
                     | "right"
                     | "sideways"
+                    | "off"
+                    | "slows"
+                    | "speeds"
                     | "very"
                     | "slowly"
                     | "quickly"
@@ -449,6 +456,9 @@ mod tests {
             ("a woman jogs along the beach", "a person runs forward"),
             ("walks to the door", "a person walks forward"),
             ("walks slowly to the left", "a person walks to the right"),
+            ("walks off to the left", "a person walks to the left"),
+            ("sprints forward", "a person dashes forward at full speed"),
+            ("slows down to a walk", "a person walks forward"),
         ] {
             assert!(same_gait(a, b), "{a} / {b}");
         }

@@ -128,12 +128,16 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
     let mut clause_of: Vec<usize> = Vec::new();
     // Limb poses read from the words, held over a clause's segments (their indices).
     let mut held: Vec<(std::ops::Range<usize>, NamedPosture)> = Vec::new();
+    // The places (indices into `held`) a clause of their own put limbs in, which stay over
+    // the next clause if it leaves those limbs alone.
+    let mut lasting: Vec<usize> = Vec::new();
     for (k, words) in clauses.iter().enumerate() {
         let words = with_subject_whole(words, readers[k]);
         let words = words.as_slice();
         let reader = readers[k];
         let clause_start = segments.len();
         let notes_start = notes.len();
+        let mut lasting_now: Vec<usize> = Vec::new();
         'clause: {
             let only_stands_up =
                 || postures::stands_up(words) && movements(words, None, reader).is_none();
@@ -258,9 +262,23 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             }
             if let Some((stance, poses)) = model.is_none().then(|| standing_poses(words)).flatten()
             {
-                // "stands on the left leg while stretching the right leg out behind her".
-                segments.push(stance);
+                // "stands on the left leg while stretching the right leg out behind her". After
+                // a pose of the whole body ("drops to one knee, spreads both arms wide") the
+                // body stays in that pose.
+                let kept = segments
+                    .last()
+                    .filter(|_| stance.postures.is_none())
+                    .filter(|last| last.postures.as_ref().is_some_and(|t| t.whole_body()))
+                    .and_then(|last| postures::hold_segment(words, last))
+                    .map(|mut kept| {
+                        for key in kept.postures.iter_mut().flat_map(|t| t.keys.iter_mut()) {
+                            key.script.name = key.script.name.as_deref().map(anaphora::held_name);
+                        }
+                        kept
+                    });
+                segments.push(kept.unwrap_or(stance));
                 let span = clause_start..segments.len();
+                lasting_now.extend(held.len()..held.len() + poses.len());
                 held.extend(poses.into_iter().map(|p| (span.clone(), p)));
                 previous = None;
                 ends_standing = None;
@@ -489,6 +507,26 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
         // is named now. The prompt sets' test checks the rules never need it.
         if segments.len() == clause_start && notes.len() == notes_start && !words.is_empty() {
             notes.push(format!("\"{}\" {UNREAD}", words.join(" ")));
+        }
+        // "puts her left hand on her hip and waves with the right": a limb a clause of its
+        // own placed stays there over the next clause, unless that clause moves it or only
+        // does the same on another limb ("…, and then the right one": one after the other).
+        let repeats = anaphora::again(words).is_some();
+        for i in std::mem::replace(&mut lasting, lasting_now)
+            .into_iter()
+            .filter(|_| !repeats)
+        {
+            let parts = held[i].1.parts.clone();
+            let moved_now = held.iter().any(|(span, p)| {
+                span.start == clause_start && p.parts.iter().any(|x| parts.contains(x))
+            });
+            let free = segments[clause_start..].iter().all(|s| {
+                busy(s, &parts).is_none() && !s.postures.as_ref().is_some_and(|t| t.whole_body())
+            });
+            if held[i].0.end == clause_start && segments.len() > clause_start && free && !moved_now
+            {
+                held[i].0.end = segments.len();
+            }
         }
         clause_of.resize(segments.len(), k);
     }

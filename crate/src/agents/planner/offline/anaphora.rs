@@ -308,10 +308,13 @@ fn lateral_way(segment: &Segment) -> Option<Side> {
             return Some(if left > 0.0 { Side::Left } else { Side::Right });
         }
     }
-    let said = |side: &str| {
-        segment.base.contains(&format!("to the {side}"))
-            || segment.text.contains(&format!("to the {side}"))
+    // "to the left", but not "turning to the left" (a turn, not a way sideways).
+    let goes = |text: &str, side: &str| {
+        text.contains(&format!("to the {side}"))
+            && !text.contains(&format!("turning to the {side}"))
+            && !text.contains(&format!("turns to the {side}"))
     };
+    let said = |side: &str| goes(&segment.base, side) || goes(&segment.text, side);
     match (said("left"), said("right")) {
         (true, false) => Some(Side::Left),
         (false, true) => Some(Side::Right),

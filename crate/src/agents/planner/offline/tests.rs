@@ -1360,3 +1360,20 @@ fn a_verb_with_a_preposition_and_its_object_starts_a_clause() {
         drinks.notes
     );
 }
+
+#[test]
+fn a_limb_placed_by_a_clause_of_its_own_stays_over_the_next_clause_that_leaves_it_alone() {
+    let hip = plan(
+        "A woman puts her left hand on her hip and waves with the right.",
+        None,
+    );
+    assert_eq!(hip.clips.len(), 1, "{hip:#?}");
+    assert_eq!(hip.clips[0].text, "left hand on the hip");
+    let total: f64 = hip.segments.iter().map(|s| s.seconds).sum();
+    assert!((hip.clips[0].end - total).abs() < 1e-9, "{hip:#?}");
+    // A limbs-only clause after a pose of the whole body keeps the body in that pose.
+    let kneel = plan("A dancer drops to one knee, spreads both arms wide.", None);
+    let names: Vec<Vec<String>> = kneel.segments.iter().map(key_names).collect();
+    assert_eq!(names.len(), 2, "{kneel:#?}");
+    assert_eq!(names[1], [format!("{}, held", names[0][0])], "{kneel:#?}");
+}
