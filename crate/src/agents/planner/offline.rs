@@ -250,7 +250,12 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                         segments.push(next);
                     }
                 }
-                if planned.over_model {
+                // A clause that moves on ("from a walk to a run") is said by all its segments,
+                // not by the first.
+                let moved_on = model
+                    .as_ref()
+                    .is_some_and(|m| moves_on_in_sequence(words, m));
+                if planned.over_model && !moved_on {
                     notes.extend(said_otherwise(words, &model_segment(), matcher.as_ref()));
                 }
                 let made = &mut segments[clause_start..];
@@ -451,7 +456,7 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
                 },
             };
             let made = segment(words, &found, style.as_deref());
-            if from_rules {
+            if from_rules && !moves_on_in_sequence(words, &found) {
                 notes.extend(said_otherwise(words, &made, matcher.as_ref()));
             }
             for _ in 0..repetitions(words, &found, &mut notes) {
@@ -684,6 +689,15 @@ fn lowered_back(
     })
 }
 
+/// Whether a clause moves on from its first whole-body movement to another ("from a walk to
+/// a run"): see [`moves_on`].
+fn moves_on_in_sequence(words: &[&str], found: &Movements) -> bool {
+    found
+        .left
+        .iter()
+        .any(|&(at, action)| !action.is_gesture() && accounting::in_sequence(words, found.at, at))
+}
+
 /// The segments of the whole-body movements a clause moves on to after its first ("from a
 /// walk to a run"), each with the action it makes and carrying the clause's gestures; what
 /// else the clause names that its movement does not make is named in a note with the reason.
@@ -748,13 +762,13 @@ fn place_limb_phrases(
     let mut held: Vec<NamedPosture> = Vec::new();
     // "walking, taps his head with his left hand": the hand's words ("with his left hand")
     // say only which hand, the place is before them.
-    if let Some(pose) = touch_pose(words) {
+    if let Some(pose) = touch_pose(words).filter(|p| !made_already(made, p)) {
         hold_place(pose, &words.join(" "), made, &mut held, notes);
     }
     for (phrase, limb) in accounting::limb_phrases_without_movement(words, named) {
         let phrase_words: Vec<&str> = phrase.split(' ').collect();
         if let Some(pose) = limb_poses::limb_pose(&phrase_words) {
-            if !held.iter().any(|h| h.name == pose.name) {
+            if !held.iter().any(|h| h.name == pose.name) && !made_already(made, &pose) {
                 hold_place(pose, &phrase, made, &mut held, notes);
             }
             continue;
@@ -791,6 +805,18 @@ fn place_limb_phrases(
         ));
     }
     held
+}
+
+/// Whether the clause's own segments already hold `pose` ("…, holding the T-pose": the
+/// posture the clause names is on its segments).
+fn made_already(made: &[Segment], pose: &NamedPosture) -> bool {
+    made.iter().any(|s| {
+        s.postures.as_ref().is_some_and(|t| {
+            t.keys
+                .iter()
+                .any(|k| k.script.name.as_deref() == Some(pose.name.as_str()))
+        })
+    })
 }
 
 /// Holds `pose` (a limb's place a phrase says) over the clause's segments, unless the

@@ -104,11 +104,12 @@ pub fn movements(plan: &Plan) -> usize {
 
 /// The body parts a plan edits, sorted by name.
 pub fn edited_parts(plan: &Plan) -> Vec<String> {
-    // Every instruction of the body-part tracks: the segments' own and the plan's clips.
+    // Every clip of the body-part tracks: the segments' own instructions, and the plan's
+    // clips, whether an instruction or a place held ("with her right arm raised above her
+    // head" holds the arm up over the walk).
     let mut parts: Vec<String> = plan
         .part_clips()
         .iter()
-        .filter(|c| c.postures.is_none())
         .flat_map(|c| c.parts.iter().map(|p| p.name().to_string()))
         .collect();
     parts.sort();

@@ -290,7 +290,12 @@ fn stem(word: &str) -> &str {
     if b.len() >= 4 && b[b.len() - 1] == b[b.len() - 2] && !b"aeiou".contains(&b[b.len() - 1]) {
         w = &w[..w.len() - 1];
     }
-    w.strip_suffix('e').filter(|r| r.len() >= 3).unwrap_or(w)
+    let w = w.strip_suffix('e').filter(|r| r.len() >= 3).unwrap_or(w);
+    // A limb raised is a limb up: the names of held places say "up" ("right arm up").
+    match w {
+        "rais" | "lift" | "upward" => "up",
+        other => other,
+    }
 }
 
 /// What the planner made of a clause, in words: the segments' base texts, part

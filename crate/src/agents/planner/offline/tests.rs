@@ -1377,3 +1377,14 @@ fn a_limb_placed_by_a_clause_of_its_own_stays_over_the_next_clause_that_leaves_i
     assert_eq!(names.len(), 2, "{kneel:#?}");
     assert_eq!(names[1], [format!("{}, held", names[0][0])], "{kneel:#?}");
 }
+
+#[test]
+fn a_posture_the_clause_holds_over_its_movements_is_not_named_again() {
+    // The issue's own example: the walk and the run under one T-pose, nothing said twice.
+    let speed = plan(
+        "A woman picks up speed from a walk to a run, holding the T-pose.",
+        None,
+    );
+    assert_eq!(speed.segments.len(), 2, "{speed:#?}");
+    assert!(speed.notes.is_empty(), "{:?}", speed.notes);
+}
