@@ -813,7 +813,7 @@ test("a 60-second prompt of nine clauses plays on the CPU backend, and its clips
 
 test("a 196-frame motion without review and the reviewed walk, timed on the CPU backend", { timeout: 30 * 60_000 }, async () => {
   // Prints what issue 18's page figures are read from; no bar is asserted (the machine is
-  // shared and noisy): the figures go to MODEL_CARD.md with the run they came from.
+  // shared and noisy): the figures go to docs/experiments.md with the run they came from.
   await withPage(PLAIN_ARGS, { width: 1280, height: 800 }, async ({ page, opened }) => {
     const { plain, reviewed } = await timeGenerations(page);
     const modelLine = await page.locator("#model-line").textContent();

@@ -111,7 +111,7 @@ fn minilm_embeddings_match_the_reference() {
             min = (c, s["text"].as_str().unwrap());
         }
         // The shipped 4-bit word table costs up to three thousandths (at 8 bits the lowest is
-        // 0.9996); EVAL.md's figures hold with it (MODEL_CARD.md).
+        // 0.9996); EVAL.md's figures hold with it (docs/experiments.md).
         assert!(c >= 0.997, "cosine {c} for {:?}", s["text"]);
     }
     println!(

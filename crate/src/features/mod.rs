@@ -447,7 +447,7 @@ pub fn retime(features: &[FeatureFrame], speed: f64) -> Features {
 /// rotations, velocities and foot contacts are computed again from the new joints (features,
 /// not normalised; `turns[0]` is ignored). Training uses it to show a model performers its
 /// few actors are not: an unseen HDM05 actor reconstructs 10–14 mm worse than the seen ones
-/// (MODEL_CARD.md, Training). Returns as many rows as given (none for a motion of fewer than
+/// (docs/experiments.md, Posture augmentation). Returns as many rows as given (none for a motion of fewer than
 /// 2 rows).
 pub fn vary_posture(features: &[FeatureFrame], turns: &[Quat; NUM_JOINTS]) -> Features {
     if features.len() < 2 {

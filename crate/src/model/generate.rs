@@ -37,7 +37,7 @@ impl Default for SamplingOptions {
         SamplingOptions {
             iterations: 10,
             // Chosen on the validation split for the dataset v2 model (`coma eval --split val
-            // --guidance G`, MODEL_CARD.md): top-3 R-precision 0.64 at 2, 0.69 at 4, 0.74 at
+            // --guidance G`, docs/experiments.md): top-3 R-precision 0.64 at 2, 0.69 at 4, 0.74 at
             // 6, 0.72 at 9.
             base_guidance: 6.0,
             residual_guidance: 5.0,

@@ -149,7 +149,7 @@ impl Spam {
     /// hundred rows) waking and joining the threads around every product costs much of the
     /// time (`perf record --call-graph dwarf coma bench --train-steps 0`: 13 % in system
     /// calls); two whole passes side by side take about 0.6× the time of one batch of two
-    /// (`scripts/speed_reference.sh`, MODEL_CARD.md). With a partner the
+    /// (`scripts/speed_reference.sh`, docs/experiments.md). With a partner the
     /// unconditional pass runs there (if it fails, here). Elsewhere (WebGPU, the page
     /// without a partner) one batch of two is one pass. All give the same logits, bit for bit
     /// on the CPU (tested).
