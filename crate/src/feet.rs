@@ -23,15 +23,17 @@
 //!    which keeps every bone's length; the upper body does not move about the pelvis;
 //! 6. lifts a frame whose other joints (knees, hands, a lying body) would be under the floor;
 //! 7. writes the features again: the root's height and travel, root-relative positions and
-//!    velocities from the new joints, and the legs' 6D rotations turned by as much as their
-//!    bones turned.
+//!    velocities from the new joints, the legs' 6D rotations turned by as much as their
+//!    bones turned, and the foot contact channels as the dataset computes them from its
+//!    joints ([`crate::features::FOOT_CONTACT_THRESHOLD`]): a planted foot is marked in
+//!    contact, one the clean-up moved is not, where the model's channel said otherwise.
 //!
 //! It is deterministic (no randomness, no state: the same features give the same joints on the
 //! same build), so a share link, which carries tokens, rebuilds the same cleaned motion.
 
 use crate::features::{
     features_to_joints_with_final, recover_root, rotation_6d, set_rotation_6d, write_pose_columns,
-    FeatureFrame, Features, CONTACTS,
+    FeatureFrame, Features, CONTACTS, FOOT_CONTACT_THRESHOLD,
 };
 use crate::geom::{self, Quat, Vec3};
 use crate::limb::two_bone;
@@ -501,6 +503,10 @@ fn rewrite(features: &[FeatureFrame], original: &[Pose], poses: &[Pose]) -> Feat
                     let turned = turn.mul(rotation_6d(row, j)).normalized();
                     set_rotation_6d(&mut out, j, turned);
                 }
+            }
+            for (k, &j) in FEET.iter().enumerate() {
+                let d = geom::sub(poses[t + 1][j], pose[j]);
+                out[CONTACTS.start + k] = (geom::dot(d, d) < FOOT_CONTACT_THRESHOLD) as u8 as f32;
             }
             out
         })
