@@ -161,8 +161,9 @@ pub const FACE_JOINTS: [usize; 4] = [
     joint::L_SHOULDER,
 ];
 
-/// The character's own left or right: of a limb, of what a hand touches, of a turn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// The character's own left or right: of a limb, of what a hand touches, of a turn or of the
+/// way a path bends, of the performer's side a motion was done with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Side {
     Left,
@@ -176,6 +177,12 @@ impl Side {
             Side::Left => "left",
             Side::Right => "right",
         }
+    }
+
+    /// Whether a turn to this side is clockwise seen from above (looking down −Y): a turn to
+    /// the right is.
+    pub fn is_clockwise(self) -> bool {
+        self == Side::Right
     }
 
     /// The other side.

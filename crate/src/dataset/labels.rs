@@ -118,11 +118,7 @@ pub fn deepmimic(name: &str) -> Option<Reading> {
 }
 
 /// The performer's side a motion was done with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Side {
-    Left,
-    Right,
-}
+pub use crate::skeleton::Side;
 
 /// How much more one side must do than the other before the clip counts as one-sided: a kick
 /// lifts the kicking foot several times higher than the standing foot rises, while alternating

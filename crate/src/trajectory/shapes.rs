@@ -14,29 +14,10 @@ use serde::{Deserialize, Serialize};
 
 use super::expr::{Expr, ExprError, NonFinite};
 
-/// Which way a shape turns, as the walker sees it (see the module documentation).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Side {
-    /// Towards the walker's left (+X at the start): counter-clockwise seen from above.
-    Left,
-    /// Towards the walker's right (−X at the start): clockwise seen from above.
-    Right,
-}
-
-impl Side {
-    /// Whether this turn is clockwise seen from above (looking down −Y).
-    pub fn is_clockwise(self) -> bool {
-        self == Side::Right
-    }
-
-    /// `"left"` or `"right"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Side::Left => "left",
-            Side::Right => "right",
-        }
-    }
-}
+/// Which way a shape turns, as the walker sees it (see the module documentation): left is
+/// towards the walker's left (+X at the start), counter-clockwise seen from above; right is
+/// clockwise.
+pub use crate::skeleton::Side;
 
 /// A built-in path shape. Shapes that can turn either way carry a [`Side`]; for closed shapes
 /// (circle, square, heart, figure eight, spiral) it is the direction they are walked round, for
