@@ -40,7 +40,7 @@ const CM: f64 = 0.01;
 
 /// Where an SMPL joint comes from.
 #[derive(Clone, Copy, Debug)]
-pub enum Source {
+pub enum JointSource {
     /// The position of one Bandai joint.
     Joint(&'static str),
     /// The point `t` of the way from the first joint to the second.
@@ -48,35 +48,35 @@ pub enum Source {
 }
 
 /// The source of each SMPL joint, in SMPL joint order.
-pub const MAPPING: [Source; NUM_JOINTS] = [
-    Source::Joint("Hips"),
-    Source::Joint("UpperLeg_L"),
-    Source::Joint("UpperLeg_R"),
-    Source::Joint("Spine"),
-    Source::Joint("LowerLeg_L"),
-    Source::Joint("LowerLeg_R"),
-    Source::Between("Spine", "Chest", 0.5),
-    Source::Joint("Foot_L"),
-    Source::Joint("Foot_R"),
-    Source::Joint("Chest"),
-    Source::Joint("Toes_L"),
-    Source::Joint("Toes_R"),
-    Source::Joint("Neck"),
-    Source::Joint("Shoulder_L"),
-    Source::Joint("Shoulder_R"),
-    Source::Joint("Head"),
-    Source::Joint("UpperArm_L"),
-    Source::Joint("UpperArm_R"),
-    Source::Joint("LowerArm_L"),
-    Source::Joint("LowerArm_R"),
-    Source::Joint("Hand_L"),
-    Source::Joint("Hand_R"),
+pub const MAPPING: [JointSource; NUM_JOINTS] = [
+    JointSource::Joint("Hips"),
+    JointSource::Joint("UpperLeg_L"),
+    JointSource::Joint("UpperLeg_R"),
+    JointSource::Joint("Spine"),
+    JointSource::Joint("LowerLeg_L"),
+    JointSource::Joint("LowerLeg_R"),
+    JointSource::Between("Spine", "Chest", 0.5),
+    JointSource::Joint("Foot_L"),
+    JointSource::Joint("Foot_R"),
+    JointSource::Joint("Chest"),
+    JointSource::Joint("Toes_L"),
+    JointSource::Joint("Toes_R"),
+    JointSource::Joint("Neck"),
+    JointSource::Joint("Shoulder_L"),
+    JointSource::Joint("Shoulder_R"),
+    JointSource::Joint("Head"),
+    JointSource::Joint("UpperArm_L"),
+    JointSource::Joint("UpperArm_R"),
+    JointSource::Joint("LowerArm_L"),
+    JointSource::Joint("LowerArm_R"),
+    JointSource::Joint("Hand_L"),
+    JointSource::Joint("Hand_R"),
 ];
 
 fn names() -> impl Iterator<Item = &'static str> {
     MAPPING.iter().flat_map(|s| match *s {
-        Source::Joint(a) => vec![a],
-        Source::Between(a, b, _) => vec![a, b],
+        JointSource::Joint(a) => vec![a],
+        JointSource::Between(a, b, _) => vec![a, b],
     })
 }
 
@@ -99,8 +99,8 @@ pub fn retarget(bvh: &Bvh) -> Result<Vec<Pose>, BvhError> {
         .iter()
         .map(|s| {
             Ok(match *s {
-                Source::Joint(a) => (index(a)?, index(a)?, 0.0),
-                Source::Between(a, b, t) => (index(a)?, index(b)?, t),
+                JointSource::Joint(a) => (index(a)?, index(a)?, 0.0),
+                JointSource::Between(a, b, t) => (index(a)?, index(b)?, t),
             })
         })
         .collect::<Result<Vec<_>, BvhError>>()?;

@@ -50,39 +50,10 @@ pub const CAPTIONS_PER_ITEM: usize = 4;
 /// this actor), so no test performer is seen in training.
 pub const HDM05_TEST_ACTORS: [&str; 1] = ["tr"];
 
-/// A motion capture source, with the terms its derived files and weights carry.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Source {
-    Bandai,
-    Hdm05,
-    Cmu,
-    DeepMimic,
-}
+pub use crate::mocap::Source;
 
+/// Where a source's clips go.
 impl Source {
-    /// The licence of the source data, which every derived file inherits.
-    pub fn licence(self) -> &'static str {
-        match self {
-            Source::Bandai => "CC BY-NC 4.0",
-            Source::Hdm05 => "CC BY-SA 3.0",
-            Source::Cmu => {
-                "CMU Graphics Lab Motion Capture Database terms (free to use, not to resell)"
-            }
-            Source::DeepMimic => "MIT",
-        }
-    }
-
-    /// The attribution the licence asks for.
-    pub fn attribution(self) -> &'static str {
-        match self {
-            Source::Bandai => "Bandai Namco Research Motion Datasets 1 and 2 (Kobayashi et al. 2023, \"Motion Capture Dataset for Practical Use of AI-based Motion Editing and Stylization\", arXiv:2306.08861)",
-            Source::Hdm05 => "The data used in this project was obtained from HDM05 (Müller, Röder, Clausen, Eberhardt, Krüger, Weber, \"Documentation Mocap Database HDM05\", Tech. Rep. CG-2007-2, Universität Bonn, 2007). Converted motion files are CC BY-SA 3.0 (ShareAlike).",
-            Source::Cmu => "The data used in this project was obtained from mocap.cs.cmu.edu, created with funding from NSF EIA-0196217; exponential-map conversion by Li et al. (CVPR 2018, MIT) as distributed by DMGNN (MIT)",
-            Source::DeepMimic => "DeepMimic motion clips, Copyright (c) 2018 Xue Bin Peng (MIT licence)",
-        }
-    }
-
     /// Which split a clip of this source goes to, when the source itself decides it: HDM05 by
     /// actor (`hdm05_test_actors` are held out for testing), CMU by the source's own split,
     /// DeepMimic always training (one clip per action, so holding one out would remove the
@@ -99,16 +70,6 @@ impl Source {
             Source::Hdm05 if hdm05_test_actors.iter().any(|a| a == actor) => Some(Split::Test),
             Source::Cmu if source_test => Some(Split::Test),
             _ => Some(Split::Train),
-        }
-    }
-}
-
-impl From<mocap::Source> for Source {
-    fn from(s: mocap::Source) -> Source {
-        match s {
-            mocap::Source::Hdm05 => Source::Hdm05,
-            mocap::Source::Cmu => Source::Cmu,
-            mocap::Source::DeepMimic => Source::DeepMimic,
         }
     }
 }
@@ -528,7 +489,7 @@ fn read_sources(options: &BuildOptions, progress: &(dyn Fn(&str) + Sync)) -> Res
                     take.label
                 )
             })?;
-            let source = Source::from(take.source);
+            let source = take.source;
             let source_test = mocap::cmu_expmap::source_split_is_test(&take.stem);
             let split = source
                 .split(&take.actor, source_test, &hdm05_test_actors)

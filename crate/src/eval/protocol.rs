@@ -151,7 +151,7 @@ pub struct Protocol<'a> {
 }
 
 /// A source of motions answering captions.
-pub enum Source<'a> {
+pub enum Motions<'a> {
     /// The test motion the caption belongs to.
     Real,
     /// The training motion whose caption is nearest (MiniLM cosine) to the test caption.
@@ -159,7 +159,7 @@ pub enum Source<'a> {
     /// SPAM, generating a motion of the test motion's length from the caption with these
     /// sampling options (each motion's seed replaces theirs).
     Spam(&'a Spam, &'a SamplingOptions),
-    /// The very motions of [`Source::Spam`] (same captions, lengths and seeds) as the VQ-VAE
+    /// The very motions of [`Motions::Spam`] (same captions, lengths and seeds) as the VQ-VAE
     /// decodes them, before the engine's clean-up (reference skeleton, planted feet): what
     /// the clean-up costs or gains in every figure. Decoded once for both rows.
     SpamDecoded(&'a Spam, &'a SamplingOptions),
@@ -265,7 +265,7 @@ impl Protocol<'_> {
     /// Runs the protocol for every source; `progress` hears about each repetition.
     pub fn run(
         &self,
-        sources: &[(&str, Source)],
+        sources: &[(&str, Motions)],
         options: &ProtocolOptions,
         progress: &dyn Fn(&str),
     ) -> Result<BTreeMap<String, Row>> {
@@ -308,23 +308,23 @@ impl Protocol<'_> {
                 .collect();
             let texts = self.evaluator.embed_texts(&sentences, self.device);
             for ((name, source), fig) in sources.iter().zip(&mut figures) {
-                if matches!(source, Source::ReviewedSpam { repeats, .. } if repeat >= *repeats) {
+                if matches!(source, Motions::ReviewedSpam { repeats, .. } if repeat >= *repeats) {
                     continue;
                 }
                 let features: Vec<&[FeatureFrame]>;
                 let generated: Vec<Vec<FeatureFrame>>;
                 match source {
-                    Source::Real => {
+                    Motions::Real => {
                         features = order.iter().map(|&i| all[i]).collect();
                     }
-                    Source::Retrieval => {
+                    Motions::Retrieval => {
                         features = captions
                             .iter()
                             .map(|c| self.train.items[nearest[c]].features.as_slice())
                             .collect();
                     }
-                    Source::Spam(spam, sampling) | Source::SpamDecoded(spam, sampling) => {
-                        let planted = matches!(source, Source::Spam(..));
+                    Motions::Spam(spam, sampling) | Motions::SpamDecoded(spam, sampling) => {
+                        let planted = matches!(source, Motions::Spam(..));
                         let normalizer = &self.test.normalizer;
                         let generate = |sentence: &[f32; TEXT_DIM], frames: usize, seed: u64| {
                             let decoded = decoded_by_seed
@@ -381,7 +381,7 @@ impl Protocol<'_> {
                             &mut rng,
                         ));
                     }
-                    Source::ReviewedSpam {
+                    Motions::ReviewedSpam {
                         session, rounds, ..
                     } => {
                         generated = captions
@@ -409,7 +409,7 @@ impl Protocol<'_> {
                     .iter()
                     .map(|j| floor_penetration(j))
                     .fold(fig.floor_penetration, f64::max);
-                if matches!(source, Source::Retrieval) {
+                if matches!(source, Motions::Retrieval) {
                     // The same caption always retrieves the same motion.
                     fig.multimodality.push(0.0);
                 }

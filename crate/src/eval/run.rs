@@ -9,7 +9,7 @@ use super::probes::{
     action, edit_locality, left_right, left_right_legs, quantile, ACTIONS, LOCALITY_BASE,
     LOCALITY_EDIT, LOCALITY_SEEDS,
 };
-use super::protocol::{Protocol, ProtocolOptions, Source};
+use super::protocol::{Motions, Protocol, ProtocolOptions};
 use super::references::{walk_to_bow, ActionReference};
 use super::report::{ActionFigure, EvalReport, JoinSpeeds, Probes};
 use crate::dataset::motions::MotionSet;
@@ -183,17 +183,17 @@ pub fn evaluate(options: &EvalOptions, log: &dyn Fn(&str)) -> Result<EvalReport>
             .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     }
     let agent_options = &options.agents;
-    let mut sources = vec![("real", Source::Real), ("retrieval", Source::Retrieval)];
+    let mut sources = vec![("real", Motions::Real), ("retrieval", Motions::Retrieval)];
     if let (Some(session), Some(model)) = (&session, spam) {
         sources.push((
             "spam_decoded",
-            Source::SpamDecoded(&model.spam, &options.sampling),
+            Motions::SpamDecoded(&model.spam, &options.sampling),
         ));
-        sources.push(("spam", Source::Spam(&model.spam, &options.sampling)));
+        sources.push(("spam", Motions::Spam(&model.spam, &options.sampling)));
         if agent_options.review_rounds > 0 {
             sources.push((
                 "spam_review",
-                Source::ReviewedSpam {
+                Motions::ReviewedSpam {
                     session,
                     rounds: agent_options.review_rounds,
                     repeats: agent_options.review_repeats,

@@ -20,13 +20,41 @@ use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Where a take comes from; decides its licence and attribution.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+/// A motion capture source, with the terms its derived files and weights carry; a take's
+/// source decides its licence and attribution.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Source {
+    Bandai,
     Hdm05,
     Cmu,
     DeepMimic,
+}
+
+impl Source {
+    /// The licence of the source data, which every derived file inherits.
+    pub fn licence(self) -> &'static str {
+        match self {
+            Source::Bandai => "CC BY-NC 4.0",
+            Source::Hdm05 => "CC BY-SA 3.0",
+            Source::Cmu => {
+                "CMU Graphics Lab Motion Capture Database terms (free to use, not to resell)"
+            }
+            Source::DeepMimic => "MIT",
+        }
+    }
+
+    /// The attribution the licence asks for.
+    pub fn attribution(self) -> &'static str {
+        match self {
+            Source::Bandai => "Bandai Namco Research Motion Datasets 1 and 2 (Kobayashi et al. 2023, \"Motion Capture Dataset for Practical Use of AI-based Motion Editing and Stylization\", arXiv:2306.08861)",
+            Source::Hdm05 => "The data used in this project was obtained from HDM05 (Müller, Röder, Clausen, Eberhardt, Krüger, Weber, \"Documentation Mocap Database HDM05\", Tech. Rep. CG-2007-2, Universität Bonn, 2007). Converted motion files are CC BY-SA 3.0 (ShareAlike).",
+            Source::Cmu => "The data used in this project was obtained from mocap.cs.cmu.edu, created with funding from NSF EIA-0196217; exponential-map conversion by Li et al. (CVPR 2018, MIT) as distributed by DMGNN (MIT)",
+            Source::DeepMimic => "DeepMimic motion clips, Copyright (c) 2018 Xue Bin Peng (MIT licence)",
+        }
+    }
 }
 
 /// One clip of a source on our 22 joints.
