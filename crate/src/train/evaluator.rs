@@ -175,6 +175,13 @@ pub fn train_evaluator(
     let b = config.batch_size.min(train.motions.len());
     let max_frames = config.model.max_frames();
     let epoch_steps = (train.motions.len() as f64 / b as f64).max(1.0);
+    let limits = super::run::StepLimits {
+        steps: config.steps,
+        log_every: config.log_every,
+        epoch_steps,
+        checkpoint_minutes: config.checkpoint_minutes,
+        minutes: options.minutes,
+    };
     while run.state.step < config.steps {
         let step = run.state.step;
         let mut rng = Rng::new(config.seed ^ (step as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
@@ -249,11 +256,8 @@ pub fn train_evaluator(
         model = optim.step(learning_rate(config, step), model, grads);
         run.record(b, &[loss_value, accuracy])?;
 
-        let done = run.state.step;
-        if done % config.log_every == 0 || done == config.steps {
-            progress(&run.progress_line(config.steps, done as f64 / epoch_steps));
-        }
-        if let Some(val) = val.filter(|_| done % config.eval_every == 0 || done == config.steps) {
+        let done = run.report_step(&limits, progress);
+        if let Some(val) = val.filter(|_| limits.due(done, config.eval_every)) {
             let top3 = retrieval_top3(&model.valid(), &config.model, val, &plain);
             progress(&format!(
                 "step {done}: validation top-3 R-precision {top3:.3}"
@@ -264,17 +268,7 @@ pub fn train_evaluator(
                 &format!("{done},{top3:.4}"),
             )?;
         }
-        if run.end_step(
-            &model,
-            &optim,
-            super::run::StepLimits {
-                steps: config.steps,
-                checkpoint_minutes: config.checkpoint_minutes,
-                minutes: options.minutes,
-            },
-            "text–motion evaluator",
-            progress,
-        )? {
+        if run.end_step(&model, &optim, &limits, "text–motion evaluator", progress)? {
             break;
         }
     }

@@ -31,13 +31,24 @@ impl RunState {
     }
 }
 
-/// When a loop checkpoints and stops: its total steps, minutes between checkpoints, and this
+/// When a loop logs, checkpoints and stops: its total steps, steps between log lines and the
+/// steps of one epoch (for the log's epoch count), minutes between checkpoints, and this
 /// session's time limit in minutes.
 #[derive(Clone, Copy, Debug)]
 pub struct StepLimits {
     pub steps: usize,
+    pub log_every: usize,
+    pub epoch_steps: f64,
     pub checkpoint_minutes: f64,
     pub minutes: Option<f64>,
+}
+
+impl StepLimits {
+    /// Whether step `done` is due for what a loop does every `every` steps (and always at its
+    /// last step).
+    pub fn due(&self, done: usize, every: usize) -> bool {
+        done % every.max(1) == 0 || done == self.steps
+    }
 }
 
 /// A training run's folder and bookkeeping.
@@ -269,14 +280,24 @@ impl Run {
         })
     }
 
-    /// What every loop does after a step: checkpoints (and redraws the plot titled `title`)
+    /// What every loop does first after a step it recorded: the progress line, when one is
+    /// due. Returns the steps done.
+    pub fn report_step(&mut self, limits: &StepLimits, progress: &dyn Fn(&str)) -> usize {
+        let done = self.state.step;
+        if limits.due(done, limits.log_every) {
+            progress(&self.progress_line(limits.steps, done as f64 / limits.epoch_steps));
+        }
+        done
+    }
+
+    /// What every loop does last after a step: checkpoints (and redraws the plot titled `title`)
     /// when one is due, at the last step, or when this session's minutes are up. Returns
     /// true when the loop must stop for time.
     pub fn end_step<M: burn::module::Module>(
         &mut self,
         model: &M,
         optim: &burn::optim::ModuleOptimizer,
-        limits: StepLimits,
+        limits: &StepLimits,
         title: &str,
         progress: &dyn Fn(&str),
     ) -> Result<bool> {

@@ -249,6 +249,13 @@ pub fn train_transformer(
         progress(&run.resumed_line());
     }
     let epoch_steps = (data.items.len() as f64 / config.batch_size as f64).max(1.0);
+    let limits = super::run::StepLimits {
+        steps: config.steps,
+        log_every: config.log_every,
+        epoch_steps,
+        checkpoint_minutes: config.checkpoint_minutes,
+        minutes: options.minutes,
+    };
     let weights = (config.balance != 0.0).then(|| data.draw_weights(config.balance));
     progress(&format!(
         "share of draws per action{}: {}",
@@ -302,26 +309,13 @@ pub fn train_transformer(
         model = optim.step(lr, model, grads);
         run.record(config.batch_size, &[loss_value, accuracy])?;
 
-        let done = run.state.step;
-        if done % config.log_every == 0 || done == config.steps {
-            progress(&run.progress_line(config.steps, done as f64 / epoch_steps));
-        }
+        run.report_step(&limits, progress);
         let title = if kind == Kind::Base {
             "base transformer"
         } else {
             "residual transformer"
         };
-        if run.end_step(
-            &model,
-            &optim,
-            super::run::StepLimits {
-                steps: config.steps,
-                checkpoint_minutes: config.checkpoint_minutes,
-                minutes: options.minutes,
-            },
-            title,
-            progress,
-        )? {
+        if run.end_step(&model, &optim, &limits, title, progress)? {
             break;
         }
     }

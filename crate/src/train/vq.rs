@@ -257,6 +257,13 @@ pub fn train_vq(
     let heading_l1 = SmoothL1LossConfig::new().with_beta(0.05).init();
     let epoch_steps =
         (train.frames() as f64 / (config.batch_size * config.max_frames) as f64).max(1.0);
+    let limits = super::run::StepLimits {
+        steps: config.steps,
+        log_every: config.log_every,
+        epoch_steps,
+        checkpoint_minutes: config.checkpoint_minutes,
+        minutes: options.minutes,
+    };
     while run.state.step < config.steps {
         let step = run.state.step;
         // Each step's randomness depends only on the seed and the step, so a resumed run
@@ -372,11 +379,8 @@ pub fn train_vq(
         }
         run.record(crops.batch, &values)?;
 
-        let done = run.state.step;
-        if done % config.log_every == 0 || done == config.steps {
-            progress(&run.progress_line(config.steps, done as f64 / epoch_steps));
-        }
-        let eval_due = done % config.eval_every == 0 || done == config.steps;
+        let done = run.report_step(&limits, progress);
+        let eval_due = limits.due(done, config.eval_every);
         if let Some(val) = val.as_ref().filter(|_| eval_due) {
             let e = reconstruction_errors(
                 &model.valid(),
@@ -401,17 +405,7 @@ pub fn train_vq(
                 ),
             )?;
         }
-        if run.end_step(
-            &model,
-            &optim,
-            super::run::StepLimits {
-                steps: config.steps,
-                checkpoint_minutes: config.checkpoint_minutes,
-                minutes: options.minutes,
-            },
-            "VQ-VAE training",
-            progress,
-        )? {
+        if run.end_step(&model, &optim, &limits, "VQ-VAE training", progress)? {
             break;
         }
     }
