@@ -1,5 +1,6 @@
 use super::*;
 use crate::agents::planner::prompt_set::edited_parts;
+use crate::trajectory::Trajectory;
 
 /// The committed prompt set, with what a reader sees in each prompt.
 #[derive(serde::Deserialize)]
