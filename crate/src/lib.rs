@@ -3,17 +3,18 @@
 //! Motions are 22-joint SMPL skeletons at 20 fps ([`timing`]), Y up, metres, starting at the
 //! origin facing +Z (HumanML3D conventions); see [`skeleton`] and [`features`].
 //!
-//! The modules in layers; each imports only from the layers below it (a test,
-//! `tests/module_graph.rs`, fails on any cycle):
+//! The modules in layers; each imports only from its own layer or the layers below it (a
+//! test, `tests/module_graph.rs`, fails on an import that goes up a layer and on any cycle):
 //!
 //! ```text
+//!  export                         assembling the shipped files from trained runs
+//!  eval  train  bench             the lab: the evaluation protocol (it runs the engine), training
 //!  session                        the engine: typed commands in, progress and outcomes out
-//!  eval  export  train  bench     measuring, assembling and training the networks
 //!  agents                         LLM client, planner, reviewer, the loop (pipeline)
 //!  share  plan                    share links; what the planner hands to the generator
 //!  model  text  trajectory        SPAM, the evaluator, tokens; MiniLM; paths on the ground
 //!  feet  posture                  planted feet of every motion; key postures
-//!  gltf  dataset  posecodes  render  bvh  mocap  features  figure  skeleton  timing  geom  rng  npy  …
+//!  gltf  dataset  posecodes  render  bvh  mocap  features  metrics  figure  skeleton  timing  geom  rng  npy  …
 //! ```
 //!
 //! One prompt, from the text box to the canvas: the page's prompt box sends a
@@ -44,6 +45,7 @@ pub mod figure;
 pub mod geom;
 pub mod gltf;
 pub mod limb;
+pub mod metrics;
 pub mod mocap;
 pub mod model;
 pub mod motion_file;

@@ -1,10 +1,51 @@
 //! The library's top-level modules depend on each other one way: no module reaches, through
 //! the `crate::` paths of its non-test code, a module that reaches it back. A cycle makes the
 //! layers meaningless (each side can only be understood with the other), so this test names
-//! the first one it finds, with the file of each hop.
+//! the first one it finds, with the file of each hop. And the layers are the ones `lib.rs`
+//! and the README draw ([`LAYERS`]): a module imports only from its own layer or those below;
+//! an import that goes up a layer fails, naming the file.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+
+/// The top-level modules in layers, from the top down, as `lib.rs` and the README draw them:
+/// the lab that assembles and measures above the engine, the engine above the agents, and so
+/// on down to the pure pieces (geometry, features, the metrics) at the bottom.
+const LAYERS: &[&[&str]] = &[
+    &["export"],
+    &["eval", "train", "bench"],
+    &["session"],
+    &["agents"],
+    &["share", "plan"],
+    &["model", "text", "trajectory"],
+    &["feet", "posture"],
+    &[
+        "gltf",
+        "motion_file",
+        "dataset",
+        "mocap",
+        "bvh",
+        "posecodes",
+        "render",
+        "figure",
+        "features",
+        "metrics",
+        "skeleton",
+        "limb",
+        "timing",
+        "geom",
+        "rng",
+        "npy",
+        "quant",
+        "weights",
+        "executor",
+    ],
+];
+
+/// The layer of a top-level module (0 is the top); `None` for a module no layer names.
+fn layer_of(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|l| l.contains(&module))
+}
 
 /// Top-level module → (module it names → a file that names it).
 type Graph = BTreeMap<String, BTreeMap<String, PathBuf>>;
@@ -119,6 +160,36 @@ fn top_level_modules_depend_on_each_other_one_way() {
             hops.join(", ")
         );
     }
+}
+
+#[test]
+fn every_import_goes_down_the_layers_or_stays_in_its_own() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let graph = graph(&src);
+    let mut wrong = Vec::new();
+    for (module, edges) in &graph {
+        let Some(own) = layer_of(module) else {
+            wrong.push(format!("{module} is in no layer of LAYERS"));
+            continue;
+        };
+        for (named, file) in edges {
+            match layer_of(named) {
+                Some(l) if l < own => wrong.push(format!(
+                    "{module} imports {named}, a layer above it ({})",
+                    file.display()
+                )),
+                None if graph.contains_key(named) => {
+                    wrong.push(format!("{named} is in no layer of LAYERS"))
+                }
+                _ => {}
+            }
+        }
+    }
+    wrong.sort();
+    wrong.dedup();
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    // The test sees an import that goes up: the lab's protocol runs the engine.
+    assert!(layer_of("eval") < layer_of("session") && graph["eval"].contains_key("session"));
 }
 
 #[test]

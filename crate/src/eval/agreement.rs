@@ -1,8 +1,8 @@
 //! How far two evaluators (f32 weights and their shipped f16 or quantized copy, say) disagree on the same
 //! motions and captions: `coma export evaluator` prints it before the page gets the rounding.
 
-use super::metrics::r_precision;
 use crate::features::FeatureFrame;
+use crate::metrics::r_precision;
 use crate::model::evaluator::{alignment_score, Evaluator, EvaluatorConfig};
 use crate::model::transformer::TEXT_DIM;
 use burn::prelude::*;

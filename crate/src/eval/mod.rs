@@ -1,4 +1,4 @@
-//! Measuring the model: the field's metrics computed with the text–motion evaluator
+//! Measuring the model: the field's metrics ([`crate::metrics`]) computed with the text–motion evaluator
 //! ([`crate::model::evaluator`]), how far its shipped precision moves them, the
 //! evaluation protocol and its report, control probes, and the agents' figures.
 
@@ -6,7 +6,7 @@
 #[cfg(feature = "native")]
 pub mod agents;
 pub mod agreement;
-pub mod metrics;
+
 // Measurements run natively, blocking on the model's reads.
 #[cfg(not(target_arch = "wasm32"))]
 pub mod probes;

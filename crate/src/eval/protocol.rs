@@ -3,12 +3,12 @@
 //! captions, the evaluator embeds texts and motions, and the field's metrics are computed,
 //! repeated with fresh caption draws and seeds to give a mean and a 95 % interval per figure.
 
-use super::metrics::{batch_ranks, diversity, fid, mm_dist, multimodality, r_precision, Interval};
 use super::probes::foot_skating;
 use crate::agents::llm::UreqTransport;
 use crate::dataset::motions::MotionSet;
 use crate::executor::block_on;
 use crate::features::{features_to_joints, FeatureFrame};
+use crate::metrics::{batch_ranks, diversity, fid, mm_dist, multimodality, r_precision, Interval};
 use crate::model::edit::part_text;
 use crate::model::evaluator::{Evaluator, EvaluatorConfig};
 use crate::model::generate::SamplingOptions;

@@ -251,7 +251,7 @@ impl EvalReport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::metrics::Interval;
+    use crate::metrics::Interval;
 
     fn row(repeats: usize) -> Row {
         let i = Interval {

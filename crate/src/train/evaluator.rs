@@ -5,8 +5,8 @@
 
 use super::run::Run;
 use crate::dataset::motions::MotionSet;
-use crate::eval::metrics::r_precision;
 use crate::features::FeatureFrame;
+use crate::metrics::r_precision;
 use crate::model::evaluator::{motion_batch, Evaluator, EvaluatorConfig};
 use crate::model::transformer::TEXT_DIM;
 use crate::rng::Rng;
@@ -361,8 +361,8 @@ mod tests {
         let t = trained.embed_texts(&data.embeddings, &Device::flex());
         let right = (0..24)
             .filter(|&i| {
-                let own = crate::eval::metrics::distance(&t[i % 2], &m[i]);
-                let other = crate::eval::metrics::distance(&t[1 - i % 2], &m[i]);
+                let own = crate::metrics::distance(&t[i % 2], &m[i]);
+                let other = crate::metrics::distance(&t[1 - i % 2], &m[i]);
                 own < other
             })
             .count();
