@@ -400,10 +400,8 @@ pub fn plan_for(prompt: &str, vocabulary: Option<&Vocabulary>, embed: Option<Emb
             });
             // "lifts the right knee, holds it, and then puts it down": the limbs held just
             // before.
-            let held_before: Vec<BodyPart> = held
-                .iter()
-                .filter(|(span, _)| span.end == clause_start && !span.is_empty())
-                .flat_map(|(_, p)| p.parts.clone())
+            let held_before: Vec<BodyPart> = held_just_before(&held, clause_start)
+                .flat_map(|p| p.parts.clone())
                 .collect();
             if let Some(lowered) = (model.is_none() || after_raise || !held_before.is_empty())
                 .then(|| lowered_back(words, segments.last(), &held_before))

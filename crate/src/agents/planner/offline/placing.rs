@@ -15,6 +15,16 @@ pub(super) fn gets_up(segment: &Segment) -> bool {
     }) || postures::stands_up(&segment.text.split(' ').collect::<Vec<_>>())
 }
 
+/// The limb places held over the clause that ends where the clause at `clause_start` begins.
+pub(super) fn held_just_before(
+    held: &[(std::ops::Range<usize>, NamedPosture)],
+    clause_start: usize,
+) -> impl Iterator<Item = &NamedPosture> {
+    held.iter()
+        .filter(move |(span, _)| span.end == clause_start && !span.is_empty())
+        .map(|(_, p)| p)
+}
+
 /// The limb places a clause that holds what came before keeps: those held over the clause
 /// just before (`held`, ending at `clause_start`), else the arms the segment before raised,
 /// up; `None` when there are none.
@@ -23,11 +33,7 @@ pub(super) fn kept_places(
     clause_start: usize,
     before: Option<&Segment>,
 ) -> Option<Vec<NamedPosture>> {
-    let kept: Vec<NamedPosture> = held
-        .iter()
-        .filter(|(span, _)| span.end == clause_start && !span.is_empty())
-        .map(|(_, p)| p.clone())
-        .collect();
+    let kept: Vec<NamedPosture> = held_just_before(held, clause_start).cloned().collect();
     if !kept.is_empty() {
         return Some(kept);
     }
